@@ -1,0 +1,82 @@
+#pragma once
+// Stage 2, similarity (LINEMOD section 2.5 and OpenCV's Detector::match): every template is
+// scored at every position of the coarsest level, positions over the threshold are refined
+// in a 16 x 16 cell window at the next finer level.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "vkpose/features.hpp"
+#include "vkpose/gpu_context.hpp"
+#include "vkpose/templates.hpp"
+
+namespace vkpose {
+
+struct MatchParams {
+  /// Similarity in percent a match needs; 0 % is what a random image gives (half the maximum
+  /// response per feature), 100 % a perfect match (OpenCV's convention).
+  float threshold = 80.0f;
+};
+
+/// A template found in a frame.
+struct Match {
+  int template_id = 0;
+  int x = 0, y = 0;         ///< pixels, full resolution; as OpenCV reports (may be negative)
+  float similarity = 0.0f;  ///< percent
+  int raw_score = 0;        ///< sum of feature responses (0..4 per feature) at the finest level
+  bool operator==(const Match&) const = default;
+};
+
+/// Best first: similarity, then template id, then y, then x.
+void sortMatches(std::vector<Match>& matches);
+
+/// Stage 2 on the CPU from the quantized pyramid: the reference the GPU matcher is tested
+/// against.
+std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& pyramid,
+                                           const std::vector<LinemodTemplate>& templates,
+                                           const FeatureParams& feature_params, const MatchParams& params);
+
+/// Wall-clock of the last frame's GPU work, host side.
+struct MatchTimings {
+  double upload_ms = 0;   ///< template upload when the templates or the image size changed
+  double gpu_ms = 0;      ///< the frame's single submit: features, similarity, refinement
+  double finish_ms = 0;   ///< host-side sorting and deduplication
+  std::size_t coarse_candidates = 0;
+};
+
+namespace gpu {
+class FrameFeatures;
+class Similarity;
+}  // namespace gpu
+
+/// Stages 1 and 2 on the GPU: one command buffer and one submit per frame.
+class LinemodMatcher {
+ public:
+  LinemodMatcher(GpuContext& context, FeatureParams feature_params = {}, MatchParams params = {});
+  ~LinemodMatcher();
+  LinemodMatcher(const LinemodMatcher&) = delete;
+  LinemodMatcher& operator=(const LinemodMatcher&) = delete;
+
+  /// Replaces the templates (validated here; uploaded at the next match()).
+  void setTemplates(std::vector<LinemodTemplate> templates);
+  const std::vector<LinemodTemplate>& templates() const { return templates_; }
+
+  std::vector<Match> match(const LinemodFrame& frame);
+  const MatchTimings& lastTimings() const { return timings_; }
+
+  /// The frame features of the last match() (for parity tests and debugging).
+  gpu::FrameFeatures& frameFeatures() { return *features_; }
+
+ private:
+  GpuContext& context_;
+  FeatureParams feature_params_;
+  MatchParams params_;
+  std::vector<LinemodTemplate> templates_;
+  std::unique_ptr<gpu::FrameFeatures> features_;
+  std::unique_ptr<gpu::Similarity> similarity_;
+  std::vector<LinearMemoryLayout> layouts_;
+  cv::Size uploaded_for_;  ///< frame size the templates were laid out for
+  MatchTimings timings_;
+};
+
+}  // namespace vkpose

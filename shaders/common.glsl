@@ -1,0 +1,39 @@
+// Shared by every kernel: byte/short storage, border rules and orientation bins. The C++
+// twins live in src/match/border.hpp and src/match/*_reference.cpp.
+#extension GL_EXT_shader_8bit_storage : require
+#extension GL_EXT_shader_16bit_storage : require
+
+// BORDER_REPLICATE
+int clampIndex(int i, int n) { return clamp(i, 0, n - 1); }
+
+// BORDER_REFLECT_101
+int reflect101Index(int i, int n) {
+  if (n == 1) return 0;
+  while (i < 0 || i >= n) i = i < 0 ? -i : 2 * n - 2 - i;
+  return i;
+}
+
+// Gradient orientation bin, sign ignored, bins centred on k * 22.5 degrees: exact integer
+// comparisons with tan(edge) * 2^19 (see gradientOrientationBin in C++).
+int gradientOrientationBin(int gx, int gy) {
+  if (gy < 0 || (gy == 0 && gx < 0)) {
+    gx = -gx;
+    gy = -gy;
+  }
+  uint ax = uint(abs(gx));
+  uint sy = uint(gy) << 19;
+  int b = (sy >= ax * 104287u ? 1 : 0) + (sy >= ax * 350318u ? 1 : 0) + (sy >= ax * 784652u ? 1 : 0) +
+          (sy >= ax * 2635774u ? 1 : 0);
+  return gx >= 0 ? b : (8 - b) & 7;
+}
+
+// Depth normal bin, 45-degree sectors centred on k * 45 degrees (see normalOrientationBin).
+int normalOrientationBin(int ddx, int ddy) {
+  precise float ax = float(abs(ddx));
+  precise float ay = float(abs(ddy));
+  precise float e1 = ax * 0.41421356;
+  precise float e2 = ax * 2.41421356;
+  int b = (ay >= e1 ? 1 : 0) + (ay >= e2 ? 1 : 0);
+  if (ddx >= 0) return ddy >= 0 ? b : (8 - b) & 7;
+  return ddy >= 0 ? 4 - b : 4 + b;
+}

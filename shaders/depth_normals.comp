@@ -1,0 +1,35 @@
+#version 450
+// LINEMOD's least-squares depth normals: 8 neighbours 5 px away, those differing from the
+// centre by difference_threshold or more left out; binned into 8 image-plane directions.
+#include "common.glsl"
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Depth { uint16_t depth[]; };
+layout(std430, binding = 1) writeonly buffer Labels { uint8_t labels[]; };
+layout(push_constant) uniform Push { int width; int height; int distance_threshold; int difference_threshold; } pc;
+const int R = 5;
+void main() {
+  int i = int(gl_GlobalInvocationID.x);
+  if (i >= pc.width * pc.height) return;
+  int y = i / pc.width, x = i - y * pc.width;
+  uint label = 0u;
+  int d = int(depth[i]);
+  if (y >= R && y < pc.height - R - 1 && x >= R && x < pc.width - R - 1 && d < pc.distance_threshold) {
+    int a0 = 0, a1 = 0, a3 = 0, b0 = 0, b1 = 0;
+    for (int j = -R; j <= R; j += R)
+      for (int k = -R; k <= R; k += R) {
+        if (k == 0 && j == 0) continue;
+        int delta = int(depth[i + j * pc.width + k]) - d;
+        if (abs(delta) >= pc.difference_threshold) continue;
+        a0 += k * k;
+        a1 += k * j;
+        a3 += j * j;
+        b0 += k * delta;
+        b1 += j * delta;
+      }
+    int det = a0 * a3 - a1 * a1;
+    int ddx = a3 * b0 - a1 * b1;
+    int ddy = -a1 * b0 + a0 * b1;
+    if (!(ddx == 0 && ddy == 0 && det * d == 0)) label = 1u << normalOrientationBin(ddx, ddy);
+  }
+  labels[i] = uint8_t(label);
+}

@@ -1,0 +1,31 @@
+#pragma once
+// The vkpose commands. Each registers its subcommand and flags on the CLI11 app and returns
+// the function that runs it.
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+#include "vkpose/gpu_context.hpp"
+
+namespace vkpose::cli {
+
+/// Exit codes, documented in README.md.
+enum ExitCode { kOk = 0, kBadInput = 1, kUsage = 2, kNoDevice = 3 };
+
+struct GlobalOptions {
+  int device = -1;  ///< -1: automatic
+  bool quiet = false;
+  GpuOptions gpu() const {
+    GpuOptions o;
+    if (device >= 0) o.device_index = device;
+    return o;
+  }
+};
+
+using Runner = std::function<int()>;
+
+Runner addInfoCommand(CLI::App& app, const GlobalOptions& global);
+Runner addBenchCommand(CLI::App& app, const GlobalOptions& global);
+Runner addDemoCommand(CLI::App& app, const GlobalOptions& global);
+
+}  // namespace vkpose::cli

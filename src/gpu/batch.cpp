@@ -1,0 +1,156 @@
+#include "gpu/batch.hpp"
+
+#include <cstring>
+
+#include "vkpose/error.hpp"
+
+namespace vkpose::gpu {
+namespace {
+constexpr uint32_t kSetsPerPool = 256;
+constexpr uint32_t kMaxBindings = 16;
+}  // namespace
+
+Batch::Batch(const GpuContext& ctx) : ctx_(ctx), device_(ctx.state().device) {
+  cmd_ = device_.allocateCommandBuffers({.commandPool = ctx.state().command_pool,
+                                         .level = vk::CommandBufferLevel::ePrimary,
+                                         .commandBufferCount = 1})[0];
+  fence_ = device_.createFence({});
+}
+
+Batch::~Batch() {
+  device_.destroyFence(fence_);
+  device_.freeCommandBuffers(ctx_.state().command_pool, cmd_);
+  for (auto pool : pools_) device_.destroyDescriptorPool(pool);
+}
+
+void Batch::begin() {
+  if (recording_) return;
+  cmd_.begin({.flags = vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+  recording_ = true;
+}
+
+void Batch::barrier() {
+  vk::MemoryBarrier b{.srcAccessMask = vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
+                      .dstAccessMask = vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite |
+                                       vk::AccessFlagBits::eTransferRead | vk::AccessFlagBits::eTransferWrite |
+                                       vk::AccessFlagBits::eIndirectCommandRead};
+  const auto stages = vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer |
+                      vk::PipelineStageFlagBits::eDrawIndirect;
+  cmd_.pipelineBarrier(stages, stages, {}, b, {}, {});
+}
+
+Buffer& Batch::staging(std::size_t bytes) {
+  if (staging_used_ == staging_.size()) staging_.emplace_back();
+  Buffer& b = staging_[staging_used_++];
+  b.reserve(ctx_, bytes, MemoryKind::HostVisible);
+  return b;
+}
+
+void Batch::upload(const Buffer& dst, const void* data, std::size_t bytes, std::size_t offset) {
+  if (bytes == 0) return;
+  if (offset + bytes > dst.size()) throw std::out_of_range("gpu::Batch::upload past the end of a buffer");
+  begin();
+  Buffer& s = staging(bytes);
+  std::memcpy(s.mapped(), data, bytes);
+  cmd_.copyBuffer(s.handle(), dst.handle(), vk::BufferCopy{.srcOffset = 0, .dstOffset = offset, .size = bytes});
+  barrier();
+}
+
+void Batch::fill(const Buffer& dst, uint32_t value, std::size_t bytes, std::size_t offset) {
+  begin();
+  cmd_.fillBuffer(dst.handle(), offset, bytes == VK_WHOLE_SIZE ? VK_WHOLE_SIZE : (bytes + 3) / 4 * 4, value);
+  barrier();
+}
+
+void Batch::bind(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
+                 std::size_t push_bytes) {
+  if (buffers.size() != kernel.bufferCount() || buffers.size() > kMaxBindings)
+    throw std::logic_error(std::string("kernel ") + kernel.name() + ": wrong number of buffers");
+  if (push_bytes != kernel.pushConstantBytes())
+    throw std::logic_error(std::string("kernel ") + kernel.name() + ": push-constant size mismatch");
+  begin();
+  if (pools_.empty() || sets_in_pool_ == kSetsPerPool) {
+    vk::DescriptorPoolSize size{.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = kSetsPerPool * kMaxBindings};
+    pools_.push_back(device_.createDescriptorPool({.maxSets = kSetsPerPool, .poolSizeCount = 1, .pPoolSizes = &size}));
+    sets_in_pool_ = 0;
+  }
+  auto layout = kernel.setLayout();
+  vk::DescriptorSet set =
+      device_.allocateDescriptorSets({.descriptorPool = pools_.back(), .descriptorSetCount = 1, .pSetLayouts = &layout})[0];
+  ++sets_in_pool_;
+  std::vector<vk::DescriptorBufferInfo> infos;
+  infos.reserve(buffers.size());
+  for (const auto& v : buffers) {
+    const std::size_t range = v.range ? v.range : v.buffer->size() - v.offset;
+    if (range > ctx_.device().max_storage_buffer_range)
+      throw DeviceError(std::string("kernel ") + kernel.name() + ": a binding exceeds maxStorageBufferRange");
+    infos.push_back({.buffer = v.buffer->handle(), .offset = v.offset, .range = std::max<std::size_t>(range, 4)});
+  }
+  std::vector<vk::WriteDescriptorSet> writes;
+  for (uint32_t i = 0; i < infos.size(); ++i)
+    writes.push_back({.dstSet = set,
+                      .dstBinding = i,
+                      .descriptorCount = 1,
+                      .descriptorType = vk::DescriptorType::eStorageBuffer,
+                      .pBufferInfo = &infos[i]});
+  device_.updateDescriptorSets(writes, {});
+  cmd_.bindPipeline(vk::PipelineBindPoint::eCompute, kernel.pipeline());
+  cmd_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, kernel.layout(), 0, set, {});
+  if (push_bytes)
+    cmd_.pushConstants(kernel.layout(), vk::ShaderStageFlagBits::eCompute, 0, static_cast<uint32_t>(push_bytes), push);
+}
+
+void Batch::dispatchRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
+                     std::size_t push_bytes, uint32_t gx, uint32_t gy, uint32_t gz) {
+  if (gx == 0 || gy == 0 || gz == 0) return;
+  const auto& limits = ctx_.device();
+  if (gx > limits.max_workgroup_count[0] || gy > limits.max_workgroup_count[1] || gz > limits.max_workgroup_count[2])
+    throw DeviceError(std::string("kernel ") + kernel.name() + ": too many workgroups for " + limits.name);
+  bind(kernel, buffers, push, push_bytes);
+  cmd_.dispatch(gx, gy, gz);
+  barrier();
+}
+
+void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
+                             std::size_t push_bytes, const Buffer& args) {
+  bind(kernel, buffers, push, push_bytes);
+  cmd_.dispatchIndirect(args.handle(), 0);
+  barrier();
+}
+
+void Batch::download(const Buffer& src, void* dst, std::size_t bytes, std::size_t offset) {
+  if (bytes == 0) return;
+  if (offset + bytes > src.size()) throw std::out_of_range("gpu::Batch::download past the end of a buffer");
+  begin();
+  Buffer& s = staging(bytes);
+  cmd_.copyBuffer(src.handle(), s.handle(), vk::BufferCopy{.srcOffset = offset, .dstOffset = 0, .size = bytes});
+  downloads_.push_back({&s, dst, bytes});
+}
+
+void Batch::submit() {
+  if (!recording_) return;
+  // Host reads of downloads and of host-visible buffers the kernels wrote.
+  vk::MemoryBarrier to_host{.srcAccessMask = vk::AccessFlagBits::eTransferWrite | vk::AccessFlagBits::eShaderWrite,
+                            .dstAccessMask = vk::AccessFlagBits::eHostRead};
+  cmd_.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer | vk::PipelineStageFlagBits::eComputeShader,
+                       vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+  cmd_.end();
+  recording_ = false;
+  vk::SubmitInfo submit{.commandBufferCount = 1, .pCommandBuffers = &cmd_};
+  ctx_.state().queue.submit(submit, fence_);
+  if (device_.waitForFences(fence_, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+    throw DeviceError("waiting for the GPU failed");
+  device_.resetFences(fence_);
+  for (const auto& d : downloads_) std::memcpy(d.dst, d.staging->mapped(), d.bytes);
+  downloads_.clear();
+  staging_used_ = 0;
+  for (auto pool : pools_) device_.resetDescriptorPool(pool);
+  if (pools_.size() > 1) {
+    for (std::size_t i = 1; i < pools_.size(); ++i) device_.destroyDescriptorPool(pools_[i]);
+    pools_.resize(1);
+  }
+  sets_in_pool_ = 0;
+  cmd_.reset();
+}
+
+}  // namespace vkpose::gpu

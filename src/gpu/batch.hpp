@@ -1,0 +1,77 @@
+#pragma once
+// Records everything a frame needs (uploads, dispatches, downloads) into one command buffer,
+// submitted once with one fence. A barrier follows each recorded operation, so each dispatch
+// sees the results of everything recorded before it.
+#include <cstddef>
+#include <initializer_list>
+#include <vector>
+
+#include "gpu/buffer.hpp"
+#include "gpu/kernel.hpp"
+
+namespace vkpose::gpu {
+
+class Batch {
+ public:
+  explicit Batch(const GpuContext& ctx);
+  ~Batch();
+  Batch(const Batch&) = delete;
+  Batch& operator=(const Batch&) = delete;
+
+  /// Copies `bytes` from host memory (copied now, so `data` may go away) into `dst` at `offset`.
+  void upload(const Buffer& dst, const void* data, std::size_t bytes, std::size_t offset = 0);
+  /// Fills `bytes` of `dst` at `offset` with the 32-bit word `value`.
+  void fill(const Buffer& dst, uint32_t value, std::size_t bytes = VK_WHOLE_SIZE, std::size_t offset = 0);
+  /// Records a dispatch of `groups` workgroups with the given buffers and push constants.
+  void dispatchRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
+                   std::size_t push_bytes, uint32_t groups_x, uint32_t groups_y = 1, uint32_t groups_z = 1);
+  template <class Push>
+  void dispatch(const Kernel& kernel, std::initializer_list<BufferView> buffers, const Push& push,
+                uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
+    dispatchRaw(kernel, buffers, &push, sizeof(Push), gx, gy, gz);
+  }
+  /// Like dispatch(), with the workgroup counts read on the device from `args` (3 uints).
+  void dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
+                           std::size_t push_bytes, const Buffer& args);
+  template <class Push>
+  void dispatchIndirect(const Kernel& kernel, std::initializer_list<BufferView> buffers, const Push& push,
+                        const Buffer& args) {
+    dispatchIndirectRaw(kernel, buffers, &push, sizeof(Push), args);
+  }
+  /// After submit(), `bytes` of `src` at `offset` land in `dst` (host memory that must outlive
+  /// the submit).
+  void download(const Buffer& src, void* dst, std::size_t bytes, std::size_t offset = 0);
+
+  /// Submits everything recorded, waits, copies downloads to the host, and resets the batch
+  /// for reuse (staging buffers are kept).
+  void submit();
+
+ private:
+  void begin();
+  void bind(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push, std::size_t push_bytes);
+  void barrier();
+  Buffer& staging(std::size_t bytes);
+
+  const GpuContext& ctx_;
+  vk::Device device_;
+  vk::CommandBuffer cmd_;
+  vk::Fence fence_;
+  std::vector<vk::DescriptorPool> pools_;
+  uint32_t sets_in_pool_ = 0;
+  std::vector<Buffer> staging_;
+  std::size_t staging_used_ = 0;
+  struct PendingDownload {
+    const Buffer* staging;
+    void* dst;
+    std::size_t bytes;
+  };
+  std::vector<PendingDownload> downloads_;
+  bool recording_ = false;
+};
+
+/// Workgroup count that covers `n` items with groups of `size`.
+inline uint32_t groupsFor(std::size_t n, uint32_t size) {
+  return static_cast<uint32_t>((n + size - 1) / size);
+}
+
+}  // namespace vkpose::gpu

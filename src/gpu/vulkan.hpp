@@ -1,0 +1,30 @@
+#pragma once
+// Private Vulkan-Hpp state behind vkpose::GpuContext. Only src/gpu and the GPU stage files
+// include this; public headers stay free of Vulkan types.
+#include <vulkan/vulkan.hpp>
+
+#include <atomic>
+
+#include "vkpose/gpu_context.hpp"
+
+namespace vkpose::gpu {
+
+struct ContextState {
+  vk::Instance instance;
+  vk::DebugUtilsMessengerEXT messenger;
+  vk::PhysicalDevice physical;
+  vk::Device device;
+  vk::Queue queue;
+  uint32_t queue_family = 0;
+  vk::CommandPool command_pool;
+  vk::PhysicalDeviceMemoryProperties memory;
+  GpuDeviceInfo info;
+  std::atomic<uint32_t> validation_errors{0};
+  PFN_vkCreateDebugUtilsMessengerEXT create_messenger = nullptr;
+  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
+
+  /// Index of a memory type allowed by `type_bits` with all of `flags`; throws if none.
+  uint32_t memoryType(uint32_t type_bits, vk::MemoryPropertyFlags flags) const;
+};
+
+}  // namespace vkpose::gpu

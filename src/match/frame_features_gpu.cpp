@@ -1,0 +1,122 @@
+#include "match/frame_features_gpu.hpp"
+
+#include "match/match_geometry.hpp"
+
+namespace vkpose::gpu {
+
+namespace {
+constexpr uint32_t kGroup = 64;
+struct SizePush {
+  int32_t width, height;
+};
+}  // namespace
+
+struct FrameFeatures::Kernels {
+  explicit Kernels(const GpuContext& c)
+      : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush)),
+        blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush)),
+        sobel(c, ShaderId::sobel_orientation, 3, sizeof(SizePush)),
+        vote(c, ShaderId::orientation_vote, 3, 12),
+        pyr_down(c, ShaderId::pyr_down, 2, 16),
+        normals(c, ShaderId::depth_normals, 2, 16),
+        median(c, ShaderId::median5, 2, sizeof(SizePush)),
+        downsample(c, ShaderId::downsample_labels, 2, 12),
+        spread(c, ShaderId::spread, 2, 12),
+        linearize(c, ShaderId::response_linearize, 2, 28) {}
+  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread, linearize;
+};
+
+FrameFeatures::FrameFeatures(const GpuContext& ctx, const FeatureParams& params)
+    : ctx_(ctx), params_(params), kernels_(std::make_unique<Kernels>(ctx)) {}
+
+FrameFeatures::~FrameFeatures() = default;
+
+void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts) {
+  auto& k = *kernels_;
+  const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
+  const auto sizes = match::levelSizes(full.width, full.height, params_.T.size());
+  levels_.resize(sizes.size());
+  for (std::size_t l = 0; l < sizes.size(); ++l) {
+    Level& L = levels_[l];
+    L.size = sizes[l];
+    const std::size_t n = static_cast<std::size_t>(L.size.area());
+    const SizePush sp{L.size.width, L.size.height};
+    const uint32_t groups = groupsFor(n, kGroup);
+
+    if (params_.use_colour) {
+      L.bgr.reserve(ctx_, n * 3);
+      if (l == 0) {
+        cv::Mat bgr = frame.bgr.isContinuous() ? frame.bgr : frame.bgr.clone();
+        batch.upload(L.bgr, bgr.data, n * 3);
+      } else {
+        const Level& P = levels_[l - 1];
+        const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
+        batch.dispatch(k.pyr_down, {P.bgr, L.bgr}, push, groups);
+      }
+      L.blur_rows.reserve(ctx_, n * 3 * 2);
+      L.smoothed.reserve(ctx_, n * 3);
+      L.raw_bins.reserve(ctx_, n);
+      L.magnitude.reserve(ctx_, n * 4);
+      L.labels[0].reserve(ctx_, n);
+      batch.dispatch(k.blur_rows, {L.bgr, L.blur_rows}, sp, groups);
+      batch.dispatch(k.blur_cols, {L.blur_rows, L.smoothed}, sp, groupsFor(n * 3, kGroup));
+      batch.dispatch(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, groups);
+      struct {
+        int32_t width, height;
+        float threshold_sq;
+      } vp{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
+      batch.dispatch(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, groups);
+    }
+    if (params_.use_depth) {
+      L.labels[1].reserve(ctx_, n);
+      if (l == 0) {
+        depth_.reserve(ctx_, n * 2);
+        L.depth_raw.reserve(ctx_, n);
+        cv::Mat depth = frame.depth_mm.isContinuous() ? frame.depth_mm : frame.depth_mm.clone();
+        batch.upload(depth_, depth.data, n * 2);
+        const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
+                                 params_.difference_threshold_mm};
+        batch.dispatch(k.normals, {depth_, L.depth_raw}, push, groups);
+        batch.dispatch(k.median, {L.depth_raw, L.labels[1]}, sp, groups);
+      } else {
+        const Level& P = levels_[l - 1];
+        const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
+        batch.dispatch(k.downsample, {P.labels[1], L.labels[1]}, push, groups);
+      }
+    }
+
+    // Linear memories: padding cells are never written, so zero the buffer only when its
+    // layout changes.
+    const LinearMemoryLayout& layout = layouts[l];
+    const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
+                      L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
+                      L.memory.size() == layout.total_bytes();
+    if (!same) {
+      L.memory = Buffer(ctx_, layout.total_bytes());
+      batch.fill(L.memory, 0u);
+      L.layout = layout;
+    }
+    L.spread.reserve(ctx_, n);
+    for (int m = 0; m < kModalityCount; ++m) {
+      if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
+      const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
+      batch.dispatch(k.spread, {L.labels[m], L.spread}, spush, groups);
+      const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
+      batch.dispatch(k.linearize, {L.spread, L.memory}, lpush, groups);
+    }
+  }
+}
+
+void FrameFeatures::downloadLabels(Batch& batch, std::vector<QuantizedLevel>& out) const {
+  out.assign(levels_.size(), {});
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    out[l].T = params_.T[l];
+    for (int m = 0; m < kModalityCount; ++m) {
+      if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
+      out[l].labels[m].create(levels_[l].size, CV_8UC1);
+      batch.download(levels_[l].labels[m], out[l].labels[m].data, static_cast<std::size_t>(levels_[l].size.area()));
+    }
+  }
+}
+
+}  // namespace vkpose::gpu

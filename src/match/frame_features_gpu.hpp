@@ -1,0 +1,45 @@
+#pragma once
+// Stage 1 on the GPU: records the feature kernels of every pyramid level into a batch and
+// keeps the buffers, so tests can compare each one with the CPU reference.
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "gpu/batch.hpp"
+#include "vkpose/features.hpp"
+
+namespace vkpose::gpu {
+
+class FrameFeatures {
+ public:
+  FrameFeatures(const GpuContext& ctx, const FeatureParams& params);
+  ~FrameFeatures();
+
+  /// Records uploads and kernels for `frame` into `batch`; linear memories use `layouts`.
+  void record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts);
+
+  const Buffer& labels(std::size_t level, int modality) const { return levels_[level].labels[modality]; }
+  const Buffer& memory(std::size_t level) const { return levels_[level].memory; }
+  cv::Size size(std::size_t level) const { return levels_[level].size; }
+
+  /// Records downloads of the label images into `out` (valid after batch.submit()).
+  void downloadLabels(Batch& batch, std::vector<QuantizedLevel>& out) const;
+
+ private:
+  struct Level {
+    cv::Size size;
+    Buffer bgr, blur_rows, smoothed, raw_bins, magnitude, depth_raw;
+    Buffer labels[kModalityCount];
+    Buffer spread;
+    Buffer memory;
+    LinearMemoryLayout layout;  // of `memory` as last zeroed
+  };
+  struct Kernels;
+  const GpuContext& ctx_;
+  FeatureParams params_;
+  std::unique_ptr<Kernels> kernels_;
+  std::vector<Level> levels_;
+  Buffer depth_;
+};
+
+}  // namespace vkpose::gpu

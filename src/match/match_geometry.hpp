@@ -1,0 +1,85 @@
+#pragma once
+// Conventions shared by the CPU reference matcher and the GPU matcher, so the two cannot
+// drift apart: position offsets, thresholds, refinement windows and memory layouts.
+#include <vector>
+
+#include "vkpose/features.hpp"
+#include "vkpose/matcher.hpp"
+#include "vkpose/templates.hpp"
+
+namespace vkpose::match {
+
+/// Half of the refinement window, in cells: LINEMOD refines in a 16 x 16 cell window.
+constexpr int kRefineHalf = 8;
+constexpr int kRefineWindow = 2 * kRefineHalf;
+/// Features summed in 8 bits before widening to 16 (63 * 4 = 252 < 256).
+constexpr int kFeaturesPer8Bit = 63;
+
+/// Reported position of cell c at spreading step T: the one-sided T x T spreading window
+/// means a template at cell c covers pixels c*T .. c*T+T-1; OpenCV reports c*T + this.
+inline int positionOffset(int T) { return T / 2 + (T % 2 - 1); }
+
+inline int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+/// OpenCV's percent threshold as a raw score: 0 % is 2 per feature, 100 % is 4.
+inline int rawThreshold(int feature_count, float threshold_percent) {
+  return static_cast<int>(2 * feature_count + (threshold_percent / 100.f) * (2 * feature_count) + 0.5f);
+}
+
+inline float similarityPercent(int raw_score, int feature_count) {
+  return (raw_score * 100.f) / (4 * feature_count);
+}
+
+/// Coarse-level positions of a template: every cell position whose template centre lies in
+/// the image (OpenCV only tries templates lying wholly inside, and loses the border).
+struct CoarseRange {
+  int c_lo = 0, r_lo = 0;  ///< first cell column / row (may be negative)
+  int columns = 0, rows = 0;
+};
+inline CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout) {
+  const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
+  return {-(wf / 2), -(hf / 2), layout.cells_x, layout.cells_y};
+}
+
+/// Linear-memory layouts of every level for `templates` on a `width` x `height` frame.
+std::vector<LinearMemoryLayout> makeLayouts(const std::vector<LinemodTemplate>& templates,
+                                            const FeatureParams& params, int width, int height);
+
+/// Size of each level: level 0 is the frame, each next level halves (rounding down).
+std::vector<cv::Size> levelSizes(int width, int height, std::size_t levels);
+
+}  // namespace vkpose::match
+
+namespace vkpose::match {
+
+/// A coarse-level position whose raw score passed the threshold.
+struct CoarseCandidate {
+  int template_id = 0;
+  int r = 0, c = 0;  ///< template top-left, coarse cells
+  int score = 0;
+};
+
+/// The best position of a candidate's refinement window at the finer level.
+struct RefineResult {
+  int score = 0;           ///< 0: nothing in the window
+  int best_r = 0, best_c = 0;  ///< within the 16 x 16 window
+};
+
+/// Number of features of a template at a level.
+inline int featureCount(const LinemodTemplate& t, std::size_t level) {
+  return static_cast<int>(t.levels[level].features.size());
+}
+
+/// Coarse candidate -> full-resolution x or y of the finer level's window origin, in cells.
+inline int refineWindowStart(int coarse_cell, int T_coarse, int T_fine) {
+  const int coarse_px = coarse_cell * T_coarse + positionOffset(T_coarse);
+  return floorDiv(2 * coarse_px + 1, T_fine) - kRefineHalf;
+}
+
+/// Turns candidates (and, with two levels, their refinement) into matches: positions,
+/// percentages, threshold, duplicates removed, best first. Shared by CPU and GPU paths.
+std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates, const std::vector<RefineResult>& refined,
+                                 const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
+                                 const MatchParams& params);
+
+}  // namespace vkpose::match

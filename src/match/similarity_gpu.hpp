@@ -1,0 +1,45 @@
+#pragma once
+// Stage 2 on the GPU: template headers and feature offsets on the device, coarse scoring of
+// every template, indirect refinement of the candidates, all recorded into the frame's batch.
+#include <memory>
+#include <vector>
+
+#include "gpu/batch.hpp"
+#include "match/match_geometry.hpp"
+
+namespace vkpose::gpu {
+
+class FrameFeatures;
+
+class Similarity {
+ public:
+  explicit Similarity(const GpuContext& ctx);
+  ~Similarity();
+
+  /// Lays the templates out for `layouts` (one per level) and uploads them through `batch`.
+  void setTemplates(Batch& batch, const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
+                    const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts);
+
+  /// Records coarse scoring and refinement of every template chunk.
+  void record(Batch& batch, const FrameFeatures& features);
+
+  /// After the batch's submit: the candidates and refinements. Returns false when the
+  /// candidate list overflowed (it grows; run the frame again).
+  bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
+
+ private:
+  struct Chunk {
+    int first_template = 0, template_count = 0;
+    Buffer headers[2], offsets[2];
+  };
+  struct Kernels;
+  const GpuContext& ctx_;
+  std::unique_ptr<Kernels> kernels_;
+  std::vector<Chunk> chunks_;
+  std::vector<LinearMemoryLayout> layouts_;
+  FeatureParams feature_params_;
+  uint32_t capacity_ = 1u << 16;
+  Buffer candidates_, results_, args_;
+};
+
+}  // namespace vkpose::gpu

@@ -1,0 +1,130 @@
+// Similarity, CPU reference (LINEMOD section 2.5, OpenCV's Detector::matchClass with the
+// border fixed). shaders/similarity_coarse.comp and similarity_refine.comp compute the same
+// candidates and refinements.
+#include <algorithm>
+#include <set>
+#include <tuple>
+
+#include "match/match_geometry.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/matcher.hpp"
+
+namespace vkpose {
+
+void sortMatches(std::vector<Match>& matches) {
+  std::sort(matches.begin(), matches.end(), [](const Match& a, const Match& b) {
+    return std::tie(b.similarity, a.template_id, a.y, a.x) < std::tie(a.similarity, b.template_id, b.y, b.x);
+  });
+}
+
+namespace match {
+
+std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates, const std::vector<RefineResult>& refined,
+                                 const std::vector<LinemodTemplate>& templates, const FeatureParams& fp,
+                                 const MatchParams& params) {
+  const std::size_t coarse = fp.T.size() - 1;
+  const int Tc = fp.T[coarse];
+  std::vector<Match> out;
+  std::set<std::tuple<int, int, int>> seen;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const auto& cand = candidates[i];
+    const auto& t = templates[static_cast<std::size_t>(cand.template_id)];
+    Match m;
+    m.template_id = cand.template_id;
+    if (coarse == 0) {
+      // Without refinement OpenCV reports the coarse score rounded up by half a percent.
+      m.x = cand.c * Tc + positionOffset(Tc);
+      m.y = cand.r * Tc + positionOffset(Tc);
+      m.raw_score = cand.score;
+      m.similarity = similarityPercent(cand.score, featureCount(t, 0)) + 0.5f;
+    } else {
+      const auto& ref = refined[i];
+      if (ref.score == 0) continue;
+      const int Tf = fp.T[0];
+      m.x = (refineWindowStart(cand.c, Tc, Tf) + ref.best_c) * Tf + positionOffset(Tf);
+      m.y = (refineWindowStart(cand.r, Tc, Tf) + ref.best_r) * Tf + positionOffset(Tf);
+      m.raw_score = ref.score;
+      m.similarity = similarityPercent(ref.score, featureCount(t, 0));
+      if (m.similarity < params.threshold) continue;
+    }
+    if (seen.insert({m.template_id, m.x, m.y}).second) out.push_back(m);
+  }
+  sortMatches(out);
+  return out;
+}
+
+}  // namespace match
+
+namespace {
+
+/// Sum of responses of `level`'s features for a template at cells (r, c) .. (r, c + 15).
+void scoreRow(const std::vector<uint8_t>& memory, const LinearMemoryLayout& layout, const TemplateLevel& level, int r,
+              int c, int scores[match::kRefineWindow]) {
+  const int T = layout.T;
+  std::fill(scores, scores + match::kRefineWindow, 0);
+  for (const auto& f : level.features) {
+    const std::size_t base = layout.offset(static_cast<int>(f.modality), f.bin, f.y % T, f.x % T, f.y / T + r, f.x / T + c);
+    for (int k = 0; k < match::kRefineWindow; ++k) scores[k] += memory[base + static_cast<std::size_t>(k)];
+  }
+}
+
+}  // namespace
+
+std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& pyramid,
+                                           const std::vector<LinemodTemplate>& templates,
+                                           const FeatureParams& fp, const MatchParams& params) {
+  validateFeatureParams(fp);
+  validateTemplates(templates, fp);
+  if (!(params.threshold > 0.0f && params.threshold <= 100.0f))
+    throw InputError("match threshold " + std::to_string(params.threshold) + " % is outside (0, 100]");
+  if (pyramid.size() != fp.T.size()) throw InputError("quantized pyramid has the wrong number of levels");
+  const cv::Mat& level0 = pyramid[0].labels[fp.use_colour ? 0 : 1];
+  const auto layouts = match::makeLayouts(templates, fp, level0.cols, level0.rows);
+
+  // Linear memories of every level.
+  std::vector<std::vector<uint8_t>> memories(pyramid.size());
+  for (std::size_t l = 0; l < pyramid.size(); ++l) {
+    memories[l].assign(layouts[l].total_bytes(), 0);
+    for (int m = 0; m < kModalityCount; ++m)
+      if (!pyramid[l].labels[m].empty())
+        linearizeResponseMaps(computeResponseMaps(spreadLabels(pyramid[l].labels[m], layouts[l].T)), m, layouts[l],
+                              memories[l]);
+  }
+
+  // Coarse level: every template at every position.
+  const std::size_t coarse = pyramid.size() - 1;
+  const auto& cl = layouts[coarse];
+  std::vector<match::CoarseCandidate> candidates;
+  int scores[match::kRefineWindow];
+  for (std::size_t ti = 0; ti < templates.size(); ++ti) {
+    const auto& level = templates[ti].levels[coarse];
+    const int threshold = match::rawThreshold(static_cast<int>(level.features.size()), params.threshold);
+    const auto range = match::coarseRange(level, cl);
+    for (int r = range.r_lo; r < range.r_lo + range.rows; ++r)
+      for (int c0 = range.c_lo; c0 < range.c_lo + range.columns; c0 += match::kRefineWindow) {
+        scoreRow(memories[coarse], cl, level, r, c0, scores);
+        for (int k = 0; k < match::kRefineWindow && c0 + k < range.c_lo + range.columns; ++k)
+          if (scores[k] > threshold) candidates.push_back({static_cast<int>(ti), r, c0 + k, scores[k]});
+      }
+  }
+
+  // Finer level: the best position in a 16 x 16 cell window around each candidate.
+  std::vector<match::RefineResult> refined;
+  if (coarse == 1) {
+    const auto& fl = layouts[0];
+    for (const auto& cand : candidates) {
+      const auto& level = templates[static_cast<std::size_t>(cand.template_id)].levels[0];
+      const int sr = match::refineWindowStart(cand.r, cl.T, fl.T), sc = match::refineWindowStart(cand.c, cl.T, fl.T);
+      match::RefineResult best;
+      for (int row = 0; row < match::kRefineWindow; ++row) {
+        scoreRow(memories[0], fl, level, sr + row, sc, scores);
+        for (int col = 0; col < match::kRefineWindow; ++col)
+          if (scores[col] > best.score) best = {scores[col], row, col};
+      }
+      refined.push_back(best);
+    }
+  }
+  return match::finishMatches(candidates, refined, templates, fp, params);
+}
+
+}  // namespace vkpose
