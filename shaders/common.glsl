@@ -16,6 +16,7 @@ int reflect101Index(int i, int n) {
 // Gradient orientation bin, sign ignored, bins centred on k * 22.5 degrees: exact integer
 // comparisons with tan(edge) * 2^19 (see gradientOrientationBin in C++).
 int gradientOrientationBin(int gx, int gy) {
+  if (gy == 0) return 0;
   if (gy < 0 || (gy == 0 && gx < 0)) {
     gx = -gx;
     gy = -gy;
@@ -29,6 +30,7 @@ int gradientOrientationBin(int gx, int gy) {
 
 // Depth normal bin, 45-degree sectors centred on k * 45 degrees (see normalOrientationBin).
 int normalOrientationBin(int ddx, int ddy) {
+  if (ddx == 0 && ddy == 0) return 0;
   precise float ax = float(abs(ddx));
   precise float ay = float(abs(ddy));
   precise float e1 = ax * 0.41421356;

@@ -39,18 +39,17 @@ void Batch::barrier() {
   cmd_.pipelineBarrier(stages, stages, {}, b, {}, {});
 }
 
-Buffer& Batch::staging(std::size_t bytes) {
+std::size_t Batch::staging(std::size_t bytes) {
   if (staging_used_ == staging_.size()) staging_.emplace_back();
-  Buffer& b = staging_[staging_used_++];
-  b.reserve(ctx_, bytes, MemoryKind::HostVisible);
-  return b;
+  staging_[staging_used_].reserve(ctx_, bytes, MemoryKind::HostVisible);
+  return staging_used_++;
 }
 
 void Batch::upload(const Buffer& dst, const void* data, std::size_t bytes, std::size_t offset) {
   if (bytes == 0) return;
   if (offset + bytes > dst.size()) throw std::out_of_range("gpu::Batch::upload past the end of a buffer");
   begin();
-  Buffer& s = staging(bytes);
+  Buffer& s = staging_[staging(bytes)];
   std::memcpy(s.mapped(), data, bytes);
   cmd_.copyBuffer(s.handle(), dst.handle(), vk::BufferCopy{.srcOffset = 0, .dstOffset = offset, .size = bytes});
   barrier();
@@ -122,9 +121,9 @@ void Batch::download(const Buffer& src, void* dst, std::size_t bytes, std::size_
   if (bytes == 0) return;
   if (offset + bytes > src.size()) throw std::out_of_range("gpu::Batch::download past the end of a buffer");
   begin();
-  Buffer& s = staging(bytes);
-  cmd_.copyBuffer(src.handle(), s.handle(), vk::BufferCopy{.srcOffset = offset, .dstOffset = 0, .size = bytes});
-  downloads_.push_back({&s, dst, bytes});
+  const std::size_t index = staging(bytes);
+  cmd_.copyBuffer(src.handle(), staging_[index].handle(), vk::BufferCopy{.srcOffset = offset, .dstOffset = 0, .size = bytes});
+  downloads_.push_back({index, dst, bytes});
 }
 
 void Batch::submit() {
@@ -141,7 +140,7 @@ void Batch::submit() {
   if (device_.waitForFences(fence_, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
     throw DeviceError("waiting for the GPU failed");
   device_.resetFences(fence_);
-  for (const auto& d : downloads_) std::memcpy(d.dst, d.staging->mapped(), d.bytes);
+  for (const auto& d : downloads_) std::memcpy(d.dst, staging_[d.staging].mapped(), d.bytes);
   downloads_.clear();
   staging_used_ = 0;
   for (auto pool : pools_) device_.resetDescriptorPool(pool);

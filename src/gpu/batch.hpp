@@ -50,7 +50,7 @@ class Batch {
   void begin();
   void bind(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push, std::size_t push_bytes);
   void barrier();
-  Buffer& staging(std::size_t bytes);
+  std::size_t staging(std::size_t bytes);
 
   const GpuContext& ctx_;
   vk::Device device_;
@@ -61,7 +61,7 @@ class Batch {
   std::vector<Buffer> staging_;
   std::size_t staging_used_ = 0;
   struct PendingDownload {
-    const Buffer* staging;
+    std::size_t staging;  // index into staging_ (which may reallocate)
     void* dst;
     std::size_t bytes;
   };

@@ -45,6 +45,7 @@ cv::Mat gaussianBlur7(const cv::Mat& bgr) {
 }
 
 int gradientOrientationBin(int gx, int gy) {
+  if (gy == 0) return 0;  // includes no gradient at all: atan2(0, 0) = 0 in OpenCV
   // Fold to [0, 180): the sign of a gradient carries no information (section 2.2).
   if (gy < 0 || (gy == 0 && gx < 0)) {
     gx = -gx;

@@ -11,6 +11,7 @@ namespace vkpose {
 int normalOrientationBin(int ddx, int ddy) {
   // Sector of the normal's image-plane direction, 45 degrees wide, centred on k * 45 degrees.
   // Edges at 22.5 and 67.5 degrees: float products of exact integers, identical on the GPU.
+  if (ddx == 0 && ddy == 0) return 0;  // facing the camera: bin 0, as OpenCV's table
   const float ax = static_cast<float>(std::abs(ddx)), ay = static_cast<float>(std::abs(ddy));
   const int b = (ay >= ax * 0.41421356f ? 1 : 0) + (ay >= ax * 2.41421356f ? 1 : 0);
   if (ddx >= 0) return ddy >= 0 ? b : (8 - b) & 7;

@@ -1,0 +1,131 @@
+// GPU kernels == CPU reference, bit for bit, for every integer stage: label images of both
+// modalities at every level, the linear memories, and the matches.
+#include "gpu/batch.hpp"
+#include "match/frame_features_gpu.hpp"
+#include "match/match_geometry.hpp"
+#include "tests/test_support.hpp"
+#include "vkpose/matcher.hpp"
+
+namespace vkpose {
+namespace {
+
+int countDifferent(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat diff;
+  cv::compare(a, b, diff, cv::CMP_NE);
+  return cv::countNonZero(diff);
+}
+
+void expectFeatureParity(const LinemodFrame& frame, const FeatureParams& params, const std::string& name) {
+  const auto reference = quantizeFramePyramid(frame, params);
+  auto templates = std::vector<LinemodTemplate>{};
+  const auto layouts = match::makeLayouts(templates, params, frame.bgr.cols, frame.bgr.rows);
+  gpu::FrameFeatures features(test::context(), params);
+  gpu::Batch batch(test::context());
+  features.record(batch, frame, layouts);
+  std::vector<QuantizedLevel> gpu_levels;
+  features.downloadLabels(batch, gpu_levels);
+  std::vector<std::vector<uint8_t>> gpu_memory(layouts.size());
+  for (std::size_t l = 0; l < layouts.size(); ++l) {
+    gpu_memory[l].resize(layouts[l].total_bytes());
+    batch.download(features.memory(l), gpu_memory[l].data(), gpu_memory[l].size());
+  }
+  batch.submit();
+  for (std::size_t l = 0; l < reference.size(); ++l) {
+    for (int m = 0; m < kModalityCount; ++m) {
+      if (reference[l].labels[m].empty()) continue;
+      EXPECT_EQ(countDifferent(gpu_levels[l].labels[m], reference[l].labels[m]), 0)
+          << name << ": level " << l << " modality " << m << " labels differ";
+    }
+    std::vector<uint8_t> cpu_memory(layouts[l].total_bytes(), 0);
+    for (int m = 0; m < kModalityCount; ++m)
+      if (!reference[l].labels[m].empty())
+        linearizeResponseMaps(computeResponseMaps(spreadLabels(reference[l].labels[m], layouts[l].T)), m, layouts[l],
+                              cpu_memory);
+    EXPECT_TRUE(cpu_memory == gpu_memory[l]) << name << ": level " << l << " linear memories differ";
+  }
+}
+
+TEST(GpuParity, FrameFeaturesOnRealFrames) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  expectFeatureParity(test::lmoFrame(), {}, "LM-O");
+  expectFeatureParity(test::icbinFrame(), {}, "IC-BIN");
+}
+
+TEST(GpuParity, FrameFeaturesOnOddSizes) {
+  for (cv::Size size : {cv::Size(127, 93), cv::Size(17, 13), cv::Size(2, 2), cv::Size(641, 3)}) {
+    LinemodFrame f;
+    f.bgr.create(size, CV_8UC3);
+    cv::randu(f.bgr, 0, 256);
+    f.depth_mm.create(size, CV_16UC1);
+    cv::randu(f.depth_mm, 500, 540);
+    FeatureParams p;
+    p.T = {3, 7};
+    expectFeatureParity(f, p, std::to_string(size.width) + "x" + std::to_string(size.height));
+  }
+}
+
+void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, int template_count, float threshold) {
+  const auto templates = test::templatesFrom(frame, params, template_count);
+  ASSERT_GT(templates.size(), 10u);
+  MatchParams mp;
+  mp.threshold = threshold;
+  const auto reference = matchTemplatesReference(quantizeFramePyramid(frame, params), templates, params, mp);
+  LinemodMatcher matcher(test::context(), params, mp);
+  matcher.setTemplates(templates);
+  const auto ours = matcher.match(frame);
+  EXPECT_GT(reference.size(), 0u);
+  ASSERT_EQ(ours.size(), reference.size());
+  for (std::size_t i = 0; i < ours.size(); ++i) ASSERT_EQ(ours[i], reference[i]) << "match " << i;
+  // A second run of the same frame gives the very same matches.
+  EXPECT_EQ(matcher.match(frame), ours);
+}
+
+TEST(GpuParity, MatchesOnRealFramesBothModalities) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  expectMatchParity(test::lmoFrame(), {}, 60, 80.0f);
+  expectMatchParity(test::icbinFrame(), {}, 60, 80.0f);
+}
+
+TEST(GpuParity, MatchesWithOneModalityAndOneLevel) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  FeatureParams colour_only;
+  colour_only.use_depth = false;
+  expectMatchParity(test::lmoFrame(), colour_only, 40, 75.0f);
+  FeatureParams one_level;
+  one_level.T = {4};
+  expectMatchParity(test::lmoFrame(), one_level, 30, 85.0f);
+}
+
+TEST(GpuParity, TemplatesWithMoreThan63FeaturesUse16BitSums) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const auto frame = test::lmoFrame();
+  auto templates = test::templatesFrom(frame, {}, 20);
+  ASSERT_FALSE(templates.empty());
+  // Merge templates pairwise into ones with 126+ features per modality per level.
+  std::vector<LinemodTemplate> big;
+  for (std::size_t i = 0; i + 1 < templates.size(); i += 2) {
+    LinemodTemplate t = templates[i];
+    for (std::size_t l = 0; l < t.levels.size(); ++l) {
+      const auto& other = templates[i + 1].levels[l];
+      t.levels[l].width = std::max(t.levels[l].width, other.width);
+      t.levels[l].height = std::max(t.levels[l].height, other.height);
+      t.levels[l].features.insert(t.levels[l].features.end(), other.features.begin(), other.features.end());
+    }
+    big.push_back(t);
+  }
+  ASSERT_GT(big.front().levels[0].features.size(), 200u);
+  MatchParams mp;
+  mp.threshold = 50.0f;
+  const auto reference = matchTemplatesReference(quantizeFramePyramid(frame, {}), big, {}, mp);
+  LinemodMatcher matcher(test::context(), {}, mp);
+  matcher.setTemplates(big);
+  EXPECT_EQ(matcher.match(frame), reference);
+  EXPECT_GT(reference.size(), 0u);
+  // Raw scores above 255 prove the sums did not wrap at 8 bits.
+  int max_raw = 0;
+  for (const auto& m : reference) max_raw = std::max(max_raw, m.raw_score);
+  EXPECT_GT(max_raw, 255);
+}
+
+}  // namespace
+}  // namespace vkpose

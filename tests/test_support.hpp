@@ -1,0 +1,37 @@
+#pragma once
+// Shared helpers of the test suites: the real frames in ../shared/data, skipping with a
+// clear message when it is absent, and LINEMOD templates cut from a frame.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "vkpose/features.hpp"
+#include "vkpose/gpu_context.hpp"
+#include "vkpose/templates.hpp"
+
+namespace vkpose::test {
+
+std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR)
+bool haveSharedData();
+
+/// The real frames the parity tests use: LM-O scene 2 frame 3 and IC-BIN scene 2 frame 0.
+LinemodFrame lmoFrame();
+LinemodFrame icbinFrame();
+
+/// Templates cut with OpenCV's extraction from regions of `frame` (objects' boxes and
+/// random boxes); `count` at most.
+std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const FeatureParams& params, int count,
+                                           unsigned seed = 1);
+
+/// One Vulkan context shared by all tests of a process (lavapipe in CI).
+GpuContext& context();
+
+}  // namespace vkpose::test
+
+#define VKPOSE_REQUIRE_SHARED_DATA()                                                          \
+  do {                                                                                        \
+    if (!::vkpose::test::haveSharedData())                                                    \
+      GTEST_SKIP() << "../shared/data is absent: this test needs the real RGB-D frames";      \
+  } while (0)
