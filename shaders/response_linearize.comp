@@ -16,12 +16,9 @@ void main() {
   uint plane = uint(pc.stride * pc.rows);
   uint cell = uint((y / pc.T + pc.pad) * pc.stride + x / pc.T + pc.pad);
   for (int b = 0; b < 8; ++b) {
-    int best = 0;
-    for (int j = 0; j < 8; ++j) {
-      if ((s & (1u << j)) == 0u) continue;
-      int d = abs(b - j);
-      best = max(best, 4 - min(d, 8 - d));
-    }
+    // Rotate the label set so that bin b is bit 0; bins d away are then bits d and 8 - d.
+    uint r = ((s >> b) | (s << (8 - b))) & 0xFFu;
+    int best = (r & 1u) != 0u ? 4 : (r & 0x82u) != 0u ? 3 : (r & 0x44u) != 0u ? 2 : (r & 0x28u) != 0u ? 1 : 0;
     uint grid = uint(((pc.modality * 8 + b) * pc.T + y % pc.T) * pc.T + x % pc.T);
     memory[grid * plane + cell] = uint8_t(best);
   }

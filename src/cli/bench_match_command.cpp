@@ -7,6 +7,7 @@
 
 #include "bench/match_benchmark.hpp"
 #include "cli/commands.hpp"
+#include "gpu/batch.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose::cli {
@@ -54,6 +55,10 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
                      {"ratio", r.ratio},
                      {"vkpose_matches", r.vkpose_matches},
                      {"opencv_matches", r.opencv_matches}});
+    }
+    if (!gpu::kernelProfile().empty()) {
+      fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS):\n");
+      for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
     }
     if (!json_path->empty()) {
       std::ofstream f(*json_path);

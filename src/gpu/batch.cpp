@@ -1,6 +1,9 @@
 #include "gpu/batch.hpp"
 
+#include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "vkpose/error.hpp"
 
@@ -11,6 +14,8 @@ constexpr uint32_t kMaxBindings = 16;
 }  // namespace
 
 Batch::Batch(const GpuContext& ctx) : ctx_(ctx), device_(ctx.state().device) {
+  const char* env = std::getenv("VKPOSE_PROFILE_KERNELS");
+  profile_ = env && *env && std::string(env) != "0";
   cmd_ = device_.allocateCommandBuffers({.commandPool = ctx.state().command_pool,
                                          .level = vk::CommandBufferLevel::ePrimary,
                                          .commandBufferCount = 1})[0];
@@ -108,6 +113,16 @@ void Batch::dispatchRaw(const Kernel& kernel, std::initializer_list<BufferView> 
   bind(kernel, buffers, push, push_bytes);
   cmd_.dispatch(gx, gy, gz);
   barrier();
+  if (profile_) {
+    const auto t0 = std::chrono::steady_clock::now();
+    submit();
+    kernelProfile()[kernel.name()] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+}
+
+std::map<std::string, double>& kernelProfile() {
+  static std::map<std::string, double> profile;
+  return profile;
 }
 
 void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
@@ -115,6 +130,11 @@ void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<Buff
   bind(kernel, buffers, push, push_bytes);
   cmd_.dispatchIndirect(args.handle(), 0);
   barrier();
+  if (profile_) {
+    const auto t0 = std::chrono::steady_clock::now();
+    submit();
+    kernelProfile()[kernel.name()] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
 }
 
 void Batch::download(const Buffer& src, void* dst, std::size_t bytes, std::size_t offset) {

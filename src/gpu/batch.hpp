@@ -4,6 +4,8 @@
 // sees the results of everything recorded before it.
 #include <cstddef>
 #include <initializer_list>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "gpu/buffer.hpp"
@@ -67,7 +69,12 @@ class Batch {
   };
   std::vector<PendingDownload> downloads_;
   bool recording_ = false;
+  bool profile_ = false;  ///< VKPOSE_PROFILE_KERNELS=1: submit after each dispatch and time it
 };
+
+/// Milliseconds per kernel name accumulated while VKPOSE_PROFILE_KERNELS is set (the
+/// per-dispatch submits make the total slower than a normal frame).
+std::map<std::string, double>& kernelProfile();
 
 /// Workgroup count that covers `n` items with groups of `size`.
 inline uint32_t groupsFor(std::size_t n, uint32_t size) {

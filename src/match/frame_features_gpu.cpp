@@ -21,9 +21,10 @@ struct FrameFeatures::Kernels {
         normals(c, ShaderId::depth_normals, 2, 16),
         median(c, ShaderId::median5, 2, sizeof(SizePush)),
         downsample(c, ShaderId::downsample_labels, 2, 12),
+        spread_rows(c, ShaderId::spread_rows, 2, 12),
         spread(c, ShaderId::spread, 2, 12),
         linearize(c, ShaderId::response_linearize, 2, 28) {}
-  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread, linearize;
+  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
 FrameFeatures::FrameFeatures(const GpuContext& ctx, const FeatureParams& params)
@@ -97,10 +98,12 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       L.layout = layout;
     }
     L.spread.reserve(ctx_, n);
+    L.spread_rows.reserve(ctx_, n);
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
       const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
-      batch.dispatch(k.spread, {L.labels[m], L.spread}, spush, groups);
+      batch.dispatch(k.spread_rows, {L.labels[m], L.spread_rows}, spush, groups);
+      batch.dispatch(k.spread, {L.spread_rows, L.spread}, spush, groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
       batch.dispatch(k.linearize, {L.spread, L.memory}, lpush, groups);
     }

@@ -30,7 +30,7 @@ class FrameFeatures {
     cv::Size size;
     Buffer bgr, blur_rows, smoothed, raw_bins, magnitude, depth_raw;
     Buffer labels[kModalityCount];
-    Buffer spread;
+    Buffer spread_rows, spread;
     Buffer memory;
     LinearMemoryLayout layout;  // of `memory` as last zeroed
   };
