@@ -99,16 +99,20 @@ Comparison compare(const std::vector<Match>& ours, const std::vector<cv::linemod
   return c;
 }
 
+/// vkpose's GPU matches of `templates` on `frame` at 80 %, the threshold both sides use.
+constexpr float kThreshold = 80.0f;
+std::vector<Match> vkposeMatches(const LinemodFrame& frame, const FeatureParams& params,
+                                 const std::vector<LinemodTemplate>& templates) {
+  LinemodMatcher matcher(test::context(), params, MatchParams{kThreshold});
+  matcher.setTemplates(templates);
+  return matcher.match(frame);
+}
+
 void expectSameMatchesOnSharedQuantization(const LinemodFrame& frame, const char* name) {
   const FeatureParams params;
   const auto templates = test::templatesFrom(frame, params, 120, 3);
   ASSERT_GT(templates.size(), 50u);
-  MatchParams mp;
-  mp.threshold = 80.0f;
-
-  LinemodMatcher matcher(test::context(), params, mp);
-  matcher.setTemplates(templates);
-  const auto ours = matcher.match(frame);
+  const auto ours = vkposeMatches(frame, params, templates);
 
   const auto pyramid = quantizeFramePyramid(frame, params);
   std::vector<cv::Ptr<cv::linemod::Modality>> modalities;
@@ -118,7 +122,7 @@ void expectSameMatchesOnSharedQuantization(const LinemodFrame& frame, const char
   for (const auto& t : templates)
     detector.addSyntheticTemplate(toOpenCvTemplate(t, activeModalities(params)), "parity");
   std::vector<cv::linemod::Match> theirs;
-  detector.match({frame.bgr, frame.depth_mm}, mp.threshold, theirs);
+  detector.match({frame.bgr, frame.depth_mm}, kThreshold, theirs);
 
   const auto c = compare(ours, theirs, templates, frame.bgr.size());
   EXPECT_GT(c.interior_equal, 20) << name;
@@ -148,15 +152,11 @@ TEST(OpenCvParity, ColourOnlyEndToEndWithOpenCvsOwnFeatures) {
   params.use_depth = false;
   const auto templates = test::templatesFrom(frame, params, 120, 5);
   ASSERT_GT(templates.size(), 50u);
-  MatchParams mp;
-  mp.threshold = 80.0f;
-  LinemodMatcher matcher(test::context(), params, mp);
-  matcher.setTemplates(templates);
-  const auto ours = matcher.match(frame);
+  const auto ours = vkposeMatches(frame, params, templates);
   auto detector = makeOpenCvDetector(params);
   for (const auto& t : templates) detector->addSyntheticTemplate(toOpenCvTemplate(t, activeModalities(params)), "p");
   std::vector<cv::linemod::Match> theirs;
-  detector->match({frame.bgr}, mp.threshold, theirs);
+  detector->match({frame.bgr}, kThreshold, theirs);
   const auto c = compare(ours, theirs, templates, frame.bgr.size());
   EXPECT_GT(c.interior_equal, 20);
   std::cout << "[ opencv  ] LINE colour only: " << ours.size() << " vkpose, " << theirs.size()

@@ -112,12 +112,15 @@ void Batch::dispatchRaw(const Kernel& kernel, std::initializer_list<BufferView> 
     throw DeviceError(std::string("kernel ") + kernel.name() + ": too many workgroups for " + limits.name);
   bind(kernel, buffers, push, push_bytes);
   cmd_.dispatch(gx, gy, gz);
+  afterDispatch(kernel);
+}
+
+void Batch::afterDispatch(const Kernel& kernel) {
   barrier();
-  if (profile_) {
-    const auto t0 = std::chrono::steady_clock::now();
-    submit();
-    kernelProfile()[kernel.name()] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  }
+  if (!profile_) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  submit();
+  kernelProfile()[kernel.name()] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::map<std::string, double>& kernelProfile() {
@@ -129,12 +132,7 @@ void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<Buff
                              std::size_t push_bytes, const Buffer& args) {
   bind(kernel, buffers, push, push_bytes);
   cmd_.dispatchIndirect(args.handle(), 0);
-  barrier();
-  if (profile_) {
-    const auto t0 = std::chrono::steady_clock::now();
-    submit();
-    kernelProfile()[kernel.name()] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  }
+  afterDispatch(kernel);
 }
 
 void Batch::download(const Buffer& src, void* dst, std::size_t bytes, std::size_t offset) {

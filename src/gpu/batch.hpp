@@ -52,6 +52,8 @@ class Batch {
   void begin();
   void bind(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push, std::size_t push_bytes);
   void barrier();
+  /// Barrier, and with VKPOSE_PROFILE_KERNELS a submit timed under the kernel's name.
+  void afterDispatch(const Kernel& kernel);
   std::size_t staging(std::size_t bytes);
 
   const GpuContext& ctx_;
