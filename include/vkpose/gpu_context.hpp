@@ -23,6 +23,7 @@ struct GpuDeviceInfo {
   uint32_t max_workgroup_invocations = 0;
   std::array<uint32_t, 3> max_workgroup_count{};
   uint64_t device_local_memory = 0;       ///< bytes in the largest device-local heap
+  bool int64_atomics = false;             ///< 64-bit storage-buffer atomics (the template renderer)
   bool usable = false;                    ///< has the features vkpose needs (8/16-bit storage)
   std::string missing;                    ///< when not usable: what is missing
 };

@@ -104,6 +104,7 @@ GpuDeviceInfo describe(vk::PhysicalDevice pd, uint32_t index) {
   for (const auto& q : pd.getQueueFamilyProperties())
     if (q.queueFlags & vk::QueueFlagBits::eCompute) has_compute = true;
   if (!has_compute) missing += " compute queue";
+  info.int64_atomics = features.get<vk::PhysicalDeviceFeatures2>().features.shaderInt64 && f12.shaderBufferInt64Atomics;
   info.usable = missing.empty();
   info.missing = missing.empty() ? "" : missing.substr(1);
   return info;
@@ -218,7 +219,12 @@ GpuContext::GpuContext(const GpuOptions& options) : state_(std::make_unique<gpu:
                                          .pQueuePriorities = &priority};
     vk::PhysicalDeviceVulkan11Features f11{.storageBuffer16BitAccess = VK_TRUE};
     vk::PhysicalDeviceVulkan12Features f12{.pNext = &f11, .storageBuffer8BitAccess = VK_TRUE};
-    vk::DeviceCreateInfo device_info{.pNext = &f12,
+    // 64-bit atomics let the renderer keep depth and triangle id in one atomicMin.
+    const bool int64 = s.info.int64_atomics;
+    f12.shaderBufferInt64Atomics = int64 ? VK_TRUE : VK_FALSE;
+    vk::PhysicalDeviceFeatures2 core{.pNext = &f12};
+    core.features.shaderInt64 = int64 ? VK_TRUE : VK_FALSE;
+    vk::DeviceCreateInfo device_info{.pNext = &core,
                                      .queueCreateInfoCount = 1,
                                      .pQueueCreateInfos = &queue_info};
     s.device = s.physical.createDevice(device_info);

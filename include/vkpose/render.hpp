@@ -1,0 +1,55 @@
+#pragma once
+// Rendering a mesh with compute shaders (DESIGN.md stage 0: no OpenGL). Many views render
+// per submit; each gives depth, normals, mask and colour. renderReference is the plain C++
+// rasterizer the GPU kernels are tested against.
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <opencv2/core.hpp>
+
+#include "vkpose/camera.hpp"
+#include "vkpose/gpu_context.hpp"
+#include "vkpose/mesh.hpp"
+
+namespace vkpose {
+
+/// Object-to-camera pose: x_cam = R x_obj + t (metres).
+struct Pose {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();
+};
+
+/// One rendered view. Pixel centres sit at integer coordinates (x = fx X / Z + cx).
+struct Rendering {
+  cv::Mat depth;    ///< CV_32FC1: z in metres, 0 where the object is not
+  cv::Mat normals;  ///< CV_32FC3: unit normals in the camera frame, facing the camera; 0 outside
+  cv::Mat bgr;      ///< CV_8UC3: vertex colour, or grey shaded by a light at the camera
+  cv::Mat mask() const { return depth > 0.f; }
+};
+
+/// The C++ reference rasterizer: the same fixed-point coverage, depth test and float
+/// arithmetic as the GPU kernels (shaders/raster_*.comp).
+Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& pose);
+
+/// Renders a mesh on the GPU. The mesh stays on the device; render() splits the views into
+/// batches that fit the device's buffer limits, one submit per batch.
+class MeshRenderer {
+ public:
+  MeshRenderer(const GpuContext& ctx, const Mesh& mesh);
+  ~MeshRenderer();
+  MeshRenderer(const MeshRenderer&) = delete;
+  MeshRenderer& operator=(const MeshRenderer&) = delete;
+
+  std::vector<Rendering> render(const Camera& camera, const std::vector<Pose>& poses);
+  /// Views that render per submit at this image size.
+  std::size_t viewsPerBatch(const Camera& camera) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vkpose

@@ -1,0 +1,63 @@
+#version 450
+// Template rendering, pass 2: per pixel, the winning triangle's depth, normal (interpolated
+// vertex normals, or the face normal) facing the camera, and colour (interpolated vertex
+// colour, or grey shaded by a light at the camera).
+#include "raster_common.glsl"
+layout(local_size_x = 64) in;
+layout(std430, binding = 3) readonly buffer Raster { uint64_t raster[]; };
+layout(std430, binding = 4) readonly buffer Normals { vec4 normals[]; };
+layout(std430, binding = 5) readonly buffer Colours { uint colours[]; };
+layout(std430, binding = 6) writeonly buffer Depth { float depth_out[]; };
+layout(std430, binding = 7) writeonly buffer NormalOut { vec4 normal_out[]; };
+layout(std430, binding = 8) writeonly buffer ColourOut { uint colour_out[]; };
+
+uint packChannel(float c) { return uint(clamp(c, 0.0, 1.0) * 255.0 + 0.5); }
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  uint view = gl_WorkGroupID.y;
+  uint pixels = uint(pc.width * pc.height);
+  if (i >= pixels) return;
+  uint o = view * pixels + i;
+  uint64_t key = raster[o];
+  if (key == ~uint64_t(0)) {
+    depth_out[o] = 0.0;
+    normal_out[o] = vec4(0.0);
+    colour_out[o] = 0u;
+    return;
+  }
+  uint f = uint(key & 0xFFFFFFFFul);
+  Triangle t;
+  setupTriangle(view, f, t);
+  int y = int(i) / pc.width, x = int(i) - y * pc.width;
+  i64vec3 e = edgesAt(t, x, y);
+  precise float z = uintBitsToFloat(uint(key >> 32));
+  precise float inv_area = 1.0 / float(t.area);
+  precise vec3 w = vec3(float(e.x) * inv_area * t.rz[0] * z, float(e.y) * inv_area * t.rz[1] * z,
+                        float(e.z) * inv_area * t.rz[2] * z);
+  uvec4 idx = faces[f];
+  precise vec3 n;
+  if ((pc.flags & 1u) != 0u) {
+    precise vec3 m = w.x * normals[idx.x].xyz + w.y * normals[idx.y].xyz + w.z * normals[idx.z].xyz;
+    vec4 r0 = poses[3u * view], r1 = poses[3u * view + 1u], r2 = poses[3u * view + 2u];
+    n = vec3(dot(r0.xyz, m), dot(r1.xyz, m), dot(r2.xyz, m));
+  } else {
+    n = t.n;
+  }
+  precise vec3 ray = vec3((float(x) - pc.cx) / pc.fx, (float(y) - pc.cy) / pc.fy, 1.0);
+  precise float len2 = dot(n, n);
+  if (len2 > 0.0) n = n * (1.0 / sqrt(len2));
+  if (dot(n, ray) > 0.0) n = -n;
+  vec3 bgr;
+  if ((pc.flags & 2u) != 0u) {
+    precise vec3 c = w.x * unpackUnorm4x8(colours[idx.x]).xyz + w.y * unpackUnorm4x8(colours[idx.y]).xyz +
+                     w.z * unpackUnorm4x8(colours[idx.z]).xyz;
+    bgr = c;
+  } else {
+    precise float lambert = max(0.0, -dot(n, ray) * (1.0 / sqrt(dot(ray, ray))));
+    bgr = vec3(0.25 + 0.65 * lambert);
+  }
+  depth_out[o] = z;
+  normal_out[o] = vec4(n, 0.0);
+  colour_out[o] = packChannel(bgr.x) | (packChannel(bgr.y) << 8) | (packChannel(bgr.z) << 16);
+}

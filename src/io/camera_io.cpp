@@ -1,0 +1,77 @@
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "vkpose/camera.hpp"
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+void validateCamera(const Camera& c, const std::string& source) {
+  auto bad = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", source, what)); };
+  if (!(std::isfinite(c.fx) && std::isfinite(c.fy) && c.fx > 0 && c.fy > 0))
+    bad(fmt::format("focal lengths must be positive (fx {}, fy {})", c.fx, c.fy));
+  if (!(std::isfinite(c.cx) && std::isfinite(c.cy))) bad("the principal point is not finite");
+  if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
+    bad(fmt::format("image size {}x{} is outside 1..16384", c.width, c.height));
+  if (!(std::isfinite(c.depth_scale) && c.depth_scale > 0)) bad(fmt::format("depth_scale {} must be positive", c.depth_scale));
+}
+
+namespace {
+double number(const nlohmann::json& j, const char* key, const std::string& path) {
+  if (!j.contains(key) || !j[key].is_number()) throw InputError(fmt::format("{}: missing or non-numeric '{}'", path, key));
+  return j[key].get<double>();
+}
+}  // namespace
+
+Camera loadCamera(const std::string& path, const std::string& entry) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open the camera file", path));
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  if (!doc.is_object()) throw InputError(fmt::format("{}: expected a JSON object", path));
+  nlohmann::json j = doc;
+  // scene_camera.json: {"<image id>": {"cam_K": ..., "depth_scale": ...}, ...}
+  if (!doc.contains("cam_K") && !doc.contains("fx")) {
+    if (!entry.empty()) {
+      if (!doc.contains(entry)) throw InputError(fmt::format("{}: no entry '{}'", path, entry));
+      j = doc[entry];
+    } else if (!doc.empty() && doc.begin()->is_object()) {
+      j = *doc.begin();
+    }
+  }
+  if (!j.is_object()) throw InputError(fmt::format("{}: expected camera fields", path));
+  Camera c;
+  try {
+    if (j.contains("cam_K")) {
+      const auto& k = j["cam_K"];
+      if (!k.is_array() || k.size() != 9) throw InputError(fmt::format("{}: cam_K must hold 9 numbers", path));
+      for (const auto& v : k)
+        if (!v.is_number()) throw InputError(fmt::format("{}: cam_K must hold 9 numbers", path));
+      c.fx = k[0].get<double>();
+      c.cx = k[2].get<double>();
+      c.fy = k[4].get<double>();
+      c.cy = k[5].get<double>();
+    } else {
+      c.fx = number(j, "fx", path);
+      c.fy = number(j, "fy", path);
+      c.cx = number(j, "cx", path);
+      c.cy = number(j, "cy", path);
+    }
+    if (j.contains("width")) c.width = static_cast<int>(number(j, "width", path));
+    if (j.contains("height")) c.height = static_cast<int>(number(j, "height", path));
+    if (j.contains("depth_scale")) c.depth_scale = number(j, "depth_scale", path);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
+  }
+  validateCamera(c, path);
+  return c;
+}
+
+}  // namespace vkpose

@@ -1,0 +1,189 @@
+#include "vkpose/mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+MeshUnits parseMeshUnits(const std::string& text) {
+  if (text == "mm") return MeshUnits::Millimetres;
+  if (text == "m") return MeshUnits::Metres;
+  if (text == "auto") return MeshUnits::Auto;
+  throw InputError(fmt::format("unknown mesh units '{}': use mm, m or auto", text));
+}
+
+uint64_t fnv1a64(const void* data, std::size_t size, uint64_t seed) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  uint64_t h = seed;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= bytes[i];
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+float exactDiameter(const std::vector<Eigen::Vector3f>& points) {
+  if (points.size() < 2) return 0.f;
+  Eigen::Vector3f lo = points[0], hi = points[0];
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3f c = 0.5f * (lo + hi);
+  // Lower bound: the extreme points along 13 directions (axes, face and body diagonals).
+  float best = 0.f;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = 0; dz <= 1; ++dz) {
+        const Eigen::Vector3f d(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
+        if (dz == 0 && (dy < 0 || (dy == 0 && dx <= 0))) continue;  // one of each +-d pair
+        std::size_t imin = 0, imax = 0;
+        for (std::size_t i = 1; i < points.size(); ++i) {
+          const float s = d.dot(points[i]);
+          if (s < d.dot(points[imin])) imin = i;
+          if (s > d.dot(points[imax])) imax = i;
+        }
+        best = std::max(best, (points[imax] - points[imin]).norm());
+      }
+  // Exact search: |p - q| <= |p - c| + |q - c|, so with points sorted by distance from c,
+  // the inner loop stops as soon as the two radii cannot beat the best pair found.
+  std::vector<std::pair<float, std::size_t>> radii(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) radii[i] = {(points[i] - c).norm(), i};
+  std::sort(radii.begin(), radii.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  float best_sq = best * best;
+  for (std::size_t i = 0; i < radii.size(); ++i) {
+    if (radii[i].first + radii[0].first < best) break;
+    const Eigen::Vector3f& p = points[radii[i].second];
+    for (std::size_t j = i + 1; j < radii.size(); ++j) {
+      if (radii[i].first + radii[j].first < best) break;
+      const float d2 = (p - points[radii[j].second]).squaredNorm();
+      if (d2 > best_sq) {
+        best_sq = d2;
+        best = std::sqrt(d2);
+      }
+    }
+  }
+  return best;
+}
+
+void finishMesh(Mesh& mesh) {
+  if (mesh.faces.empty() || mesh.vertices.empty()) throw InputError(fmt::format("mesh '{}' has no triangles", mesh.name));
+  const int n = static_cast<int>(mesh.vertices.size());
+  for (const auto& v : mesh.vertices)
+    if (!v.allFinite()) throw InputError(fmt::format("mesh '{}' has a NaN or infinite vertex", mesh.name));
+  for (const auto& f : mesh.faces)
+    if (f.minCoeff() < 0 || f.maxCoeff() >= n)
+      throw InputError(fmt::format("mesh '{}' has a face with a vertex index out of range", mesh.name));
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.vertices.size())
+    throw InputError(fmt::format("mesh '{}': {} normals for {} vertices", mesh.name, mesh.normals.size(), n));
+  if (!mesh.colours.empty() && mesh.colours.size() != mesh.vertices.size())
+    throw InputError(fmt::format("mesh '{}': {} colours for {} vertices", mesh.name, mesh.colours.size(), n));
+  mesh.bbox_min = mesh.bbox_max = mesh.vertices[0];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& v : mesh.vertices) {
+    mesh.bbox_min = mesh.bbox_min.cwiseMin(v);
+    mesh.bbox_max = mesh.bbox_max.cwiseMax(v);
+    sum += v.cast<double>();
+  }
+  mesh.centroid = (sum / n).cast<float>();
+  mesh.diameter = exactDiameter(mesh.vertices);
+  if (!(mesh.diameter > 0.f)) throw InputError(fmt::format("mesh '{}' has zero size", mesh.name));
+  for (auto& nrm : mesh.normals) {
+    const float len = nrm.norm();
+    nrm = len > 0.f && std::isfinite(len) ? Eigen::Vector3f(nrm / len) : Eigen::Vector3f::Zero();
+  }
+}
+
+namespace {
+std::vector<char> readFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(fmt::format("{}: no such mesh file", path));
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw InputError(fmt::format("{}: cannot read the file", path));
+  if (bytes.empty()) throw InputError(fmt::format("{}: the mesh file is empty", path));
+  return bytes;
+}
+}  // namespace
+
+Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) {
+  const std::vector<char> bytes = readFile(path);
+  const std::string ext = std::filesystem::path(path).extension().string();
+  Assimp::Importer importer;
+  // STL stores one normal per facet: dropping it lets identical vertices join, and the
+  // renderer then uses flat face normals, which is what a facetted STL means.
+  std::string lower_ext = ext;
+  std::transform(lower_ext.begin(), lower_ext.end(), lower_ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  const bool drop_normals = lower_ext == ".stl";
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, drop_normals ? static_cast<int>(aiComponent_NORMALS) : 0);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
+                         aiProcess_SortByPType | aiProcess_ValidateDataStructure |
+                         (drop_normals ? aiProcess_RemoveComponent : 0u);
+  const aiScene* scene =
+      importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, lower_ext.empty() ? "" : lower_ext.c_str() + 1);
+  if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode)
+    throw InputError(fmt::format("{}: not a readable mesh ({})", path, importer.GetErrorString()));
+
+  Mesh mesh;
+  mesh.name = std::filesystem::path(path).stem().string();
+  mesh.file_hash = fnv1a64(bytes.data(), bytes.size());
+  bool all_normals = true, all_colours = true;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    all_normals = all_normals && am->HasNormals();
+    all_colours = all_colours && am->HasVertexColors(0);
+  }
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    const int base = static_cast<int>(mesh.vertices.size());
+    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+      const aiVector3D& v = am->mVertices[i];
+      mesh.vertices.emplace_back(v.x, v.y, v.z);
+      if (all_normals) mesh.normals.emplace_back(am->mNormals[i].x, am->mNormals[i].y, am->mNormals[i].z);
+      if (all_colours) {
+        const aiColor4D& c = am->mColors[0][i];
+        mesh.colours.emplace_back(std::clamp(c.r, 0.f, 1.f), std::clamp(c.g, 0.f, 1.f), std::clamp(c.b, 0.f, 1.f));
+      }
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      mesh.faces.emplace_back(base + static_cast<int>(face.mIndices[0]), base + static_cast<int>(face.mIndices[1]),
+                              base + static_cast<int>(face.mIndices[2]));
+    }
+  }
+  if (mesh.faces.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", path));
+  for (const auto& v : mesh.vertices)
+    if (!v.allFinite()) throw InputError(fmt::format("{}: the mesh has a NaN or infinite vertex", path));
+
+  const float file_diameter = exactDiameter(mesh.vertices);
+  MeshUnits used = units;
+  if (units == MeshUnits::Auto) used = file_diameter > 10.f ? MeshUnits::Millimetres : MeshUnits::Metres;
+  if (used == MeshUnits::Millimetres)
+    for (auto& v : mesh.vertices) v *= 0.001f;
+  try {
+    finishMesh(mesh);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", path, e.what()));
+  }
+  if (mesh.diameter < 1e-3f || mesh.diameter > 10.f)
+    throw InputError(fmt::format("{}: the object is {:.4g} m across in {}; vkpose handles 1 mm to 10 m (check --units)",
+                                 path, mesh.diameter, used == MeshUnits::Millimetres ? "millimetres" : "metres"));
+  if (report) *report = {used, units == MeshUnits::Auto, file_diameter};
+  return mesh;
+}
+
+}  // namespace vkpose

@@ -1,0 +1,231 @@
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "gpu/batch.hpp"
+#include "gpu/buffer.hpp"
+#include "gpu/kernel.hpp"
+#include "render/raster_math.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/render.hpp"
+
+namespace vkpose {
+
+namespace {
+
+using render::ScreenParams;
+using render::Triangle;
+
+uint32_t packBgr(const Eigen::Vector3f& rgb) {
+  return render::packChannel(rgb.z()) | (render::packChannel(rgb.y()) << 8) | (render::packChannel(rgb.x()) << 16);
+}
+
+Eigen::Vector3f unpackBgr(uint32_t packed) {
+  // unpackUnorm4x8 order: component 0 is the lowest byte (blue here).
+  return {static_cast<float>(packed & 0xFF) / 255.0f, static_cast<float>((packed >> 8) & 0xFF) / 255.0f,
+          static_cast<float>((packed >> 16) & 0xFF) / 255.0f};
+}
+
+void checkRenderable(const Mesh& mesh, const Camera& camera) {
+  validateCamera(camera, "render camera");
+  if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles to render", mesh.name));
+}
+
+}  // namespace
+
+Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& pose) {
+  checkRenderable(mesh, camera);
+  const ScreenParams sp(camera);
+  const int W = camera.width, H = camera.height;
+  std::vector<uint64_t> raster(static_cast<std::size_t>(W) * H, std::numeric_limits<uint64_t>::max());
+  auto corners = [&](const Eigen::Vector3i& f) {
+    return std::array<Eigen::Vector3f, 3>{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+  };
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    Triangle t;
+    if (!render::setupTriangle(sp, pose, corners(mesh.faces[f]), t)) continue;
+    for (int y = t.box_y0; y <= t.box_y1; ++y)
+      for (int x = t.box_x0; x <= t.box_x1; ++x) {
+        const auto e = render::edgesAt(t, x, y);
+        if (e[0] < 0 || e[1] < 0 || e[2] < 0) continue;
+        const float z = render::depthAt(sp, t, x, y);
+        uint32_t bits;
+        std::memcpy(&bits, &z, 4);
+        auto& slot = raster[static_cast<std::size_t>(y) * W + x];
+        slot = std::min(slot, (uint64_t{bits} << 32) | f);
+      }
+  }
+  Rendering out;
+  out.depth = cv::Mat::zeros(H, W, CV_32FC1);
+  out.normals = cv::Mat::zeros(H, W, CV_32FC3);
+  out.bgr = cv::Mat::zeros(H, W, CV_8UC3);
+  const bool has_normals = !mesh.normals.empty(), has_colours = !mesh.colours.empty();
+  std::vector<uint32_t> colours;
+  for (const auto& c : mesh.colours) colours.push_back(packBgr(c));
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const uint64_t key = raster[static_cast<std::size_t>(y) * W + x];
+      if (key == std::numeric_limits<uint64_t>::max()) continue;
+      const auto f = static_cast<uint32_t>(key & 0xFFFFFFFFu);
+      const Eigen::Vector3i& idx = mesh.faces[f];
+      Triangle t;
+      render::setupTriangle(sp, pose, corners(idx), t);
+      const auto e = render::edgesAt(t, x, y);
+      float z;
+      const auto zbits = static_cast<uint32_t>(key >> 32);
+      std::memcpy(&z, &zbits, 4);
+      const float inv_area = 1.0f / static_cast<float>(t.area);
+      const Eigen::Vector3f w(static_cast<float>(e[0]) * inv_area * t.rz[0] * z,
+                              static_cast<float>(e[1]) * inv_area * t.rz[1] * z,
+                              static_cast<float>(e[2]) * inv_area * t.rz[2] * z);
+      Eigen::Vector3f n;
+      if (has_normals) {
+        const Eigen::Vector3f m = w.x() * mesh.normals[idx[0]] + w.y() * mesh.normals[idx[1]] + w.z() * mesh.normals[idx[2]];
+        n = render::toCamera({pose.R, Eigen::Vector3f::Zero()}, m);
+      } else {
+        n = t.n;
+      }
+      const Eigen::Vector3f ray((static_cast<float>(x) - sp.cx) / sp.fx, (static_cast<float>(y) - sp.cy) / sp.fy, 1.0f);
+      const float len2 = n.dot(n);
+      if (len2 > 0.f) n = n * (1.0f / std::sqrt(len2));
+      if (n.dot(ray) > 0.f) n = -n;
+      Eigen::Vector3f bgr;
+      if (has_colours) {
+        bgr = w.x() * unpackBgr(colours[idx[0]]) + w.y() * unpackBgr(colours[idx[1]]) + w.z() * unpackBgr(colours[idx[2]]);
+      } else {
+        const float lambert = std::max(0.0f, -n.dot(ray) * (1.0f / std::sqrt(ray.dot(ray))));
+        bgr = Eigen::Vector3f::Constant(0.25f + 0.65f * lambert);
+      }
+      out.depth.at<float>(y, x) = z;
+      out.normals.at<cv::Vec3f>(y, x) = {n.x(), n.y(), n.z()};
+      out.bgr.at<cv::Vec3b>(y, x) = {static_cast<uint8_t>(render::packChannel(bgr.x())),
+                                     static_cast<uint8_t>(render::packChannel(bgr.y())),
+                                     static_cast<uint8_t>(render::packChannel(bgr.z()))};
+    }
+  return out;
+}
+
+// ---- GPU --------------------------------------------------------------------------------
+
+namespace {
+struct RasterPush {
+  float fx, fy, cx, cy;
+  int32_t width, height;
+  uint32_t face_count, flags;
+};
+constexpr std::size_t kBatchBytes = 96u << 20;  // per-batch output budget
+constexpr std::size_t kMaxViewsPerBatch = 256;
+}  // namespace
+
+struct MeshRenderer::Impl {
+  Impl(const GpuContext& c, const Mesh& mesh)
+      : ctx(c),
+        raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush)),
+        resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush)) {
+    face_count = static_cast<uint32_t>(mesh.faces.size());
+    flags = (mesh.normals.empty() ? 0u : 1u) | (mesh.colours.empty() ? 0u : 2u);
+    std::vector<float> v4;
+    for (const auto& v : mesh.vertices) v4.insert(v4.end(), {v.x(), v.y(), v.z(), 0.f});
+    std::vector<uint32_t> f4;
+    for (const auto& f : mesh.faces)
+      f4.insert(f4.end(), {static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2]), 0u});
+    std::vector<float> n4;
+    for (const auto& n : mesh.normals) n4.insert(n4.end(), {n.x(), n.y(), n.z(), 0.f});
+    if (n4.empty()) n4.resize(4, 0.f);
+    std::vector<uint32_t> c1;
+    for (const auto& colour : mesh.colours) c1.push_back(packBgr(colour));
+    if (c1.empty()) c1.push_back(0);
+    const std::size_t max_range = ctx.device().max_storage_buffer_range;
+    if (v4.size() * 4 > max_range || f4.size() * 4 > max_range)
+      throw InputError(fmt::format("mesh '{}' is too large for one device buffer ({} triangles)", mesh.name, face_count));
+    gpu::Batch batch(ctx);
+    vertices = gpu::Buffer(ctx, v4.size() * 4);
+    faces = gpu::Buffer(ctx, f4.size() * 4);
+    normals = gpu::Buffer(ctx, n4.size() * 4);
+    colours = gpu::Buffer(ctx, c1.size() * 4);
+    batch.upload(vertices, v4.data(), v4.size() * 4);
+    batch.upload(faces, f4.data(), f4.size() * 4);
+    batch.upload(normals, n4.data(), n4.size() * 4);
+    batch.upload(colours, c1.data(), c1.size() * 4);
+    batch.submit();
+  }
+  const GpuContext& ctx;
+  gpu::Kernel raster, resolve;
+  gpu::Buffer vertices, faces, normals, colours, poses, keys, depth, normal_out, colour_out;
+  uint32_t face_count = 0, flags = 0;
+};
+
+MeshRenderer::MeshRenderer(const GpuContext& ctx, const Mesh& mesh) {
+  if (!ctx.device().int64_atomics)
+    throw DeviceError(fmt::format("the template renderer needs 64-bit buffer atomics, which {} lacks",
+                                  ctx.device().name));
+  if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles to render", mesh.name));
+  impl_ = std::make_unique<Impl>(ctx, mesh);
+}
+
+MeshRenderer::~MeshRenderer() = default;
+
+std::size_t MeshRenderer::viewsPerBatch(const Camera& camera) const {
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  // Largest per-pixel binding: the normals (16 bytes); the whole batch: 8 + 4 + 16 + 4.
+  const std::size_t by_range = impl_->ctx.device().max_storage_buffer_range / (pixels * 16);
+  const std::size_t by_budget = kBatchBytes / (pixels * 32);
+  return std::clamp<std::size_t>(std::min({by_range, by_budget, kMaxViewsPerBatch}), 1, kMaxViewsPerBatch);
+}
+
+std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses) {
+  validateCamera(camera, "render camera");
+  auto& m = *impl_;
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  if (pixels * 16 > m.ctx.device().max_storage_buffer_range)
+    throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
+  const std::size_t per_batch = viewsPerBatch(camera);
+  const RasterPush push{static_cast<float>(camera.fx), static_cast<float>(camera.fy), static_cast<float>(camera.cx),
+                        static_cast<float>(camera.cy), camera.width, camera.height, m.face_count, m.flags};
+  std::vector<Rendering> out;
+  out.reserve(poses.size());
+  std::vector<float> depth, normals;
+  std::vector<uint32_t> colour;
+  for (std::size_t first = 0; first < poses.size(); first += per_batch) {
+    const std::size_t n = std::min(per_batch, poses.size() - first);
+    std::vector<float> rows;
+    for (std::size_t v = first; v < first + n; ++v)
+      for (int r = 0; r < 3; ++r)
+        rows.insert(rows.end(), {poses[v].R(r, 0), poses[v].R(r, 1), poses[v].R(r, 2), poses[v].t(r)});
+    m.poses.reserve(m.ctx, rows.size() * 4);
+    m.keys.reserve(m.ctx, n * pixels * 8);
+    m.depth.reserve(m.ctx, n * pixels * 4);
+    m.normal_out.reserve(m.ctx, n * pixels * 16);
+    m.colour_out.reserve(m.ctx, n * pixels * 4);
+    depth.resize(n * pixels);
+    normals.resize(n * pixels * 4);
+    colour.resize(n * pixels);
+    gpu::Batch batch(m.ctx);
+    batch.upload(m.poses, rows.data(), rows.size() * 4);
+    batch.fill(m.keys, 0xFFFFFFFFu, n * pixels * 8);
+    batch.dispatch(m.raster, {m.vertices, m.faces, m.poses, m.keys}, push, gpu::groupsFor(m.face_count, 64),
+                   static_cast<uint32_t>(n));
+    batch.dispatch(m.resolve,
+                   {m.vertices, m.faces, m.poses, m.keys, m.normals, m.colours, m.depth, m.normal_out, m.colour_out},
+                   push, gpu::groupsFor(pixels, 64), static_cast<uint32_t>(n));
+    batch.download(m.depth, depth.data(), n * pixels * 4);
+    batch.download(m.normal_out, normals.data(), n * pixels * 16);
+    batch.download(m.colour_out, colour.data(), n * pixels * 4);
+    batch.submit();
+    for (std::size_t v = 0; v < n; ++v) {
+      Rendering r;
+      r.depth = cv::Mat(camera.height, camera.width, CV_32FC1, depth.data() + v * pixels).clone();
+      cv::Mat n4(camera.height, camera.width, CV_32FC4, normals.data() + v * pixels * 4);
+      cv::cvtColor(n4, r.normals, cv::COLOR_BGRA2BGR);
+      cv::Mat c4(camera.height, camera.width, CV_8UC4, colour.data() + v * pixels);
+      cv::cvtColor(c4, r.bgr, cv::COLOR_BGRA2BGR);
+      out.push_back(std::move(r));
+    }
+  }
+  return out;
+}
+
+}  // namespace vkpose

@@ -1,0 +1,105 @@
+#include "vkpose/views.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+std::vector<float> SteppedRange::values() const {
+  std::vector<float> out;
+  if (step <= 0.f) return {from};
+  // Index-based so that rounding never drops the last value or adds one past `to`.
+  const int n = static_cast<int>(std::floor((to - from) / step + 1e-4f)) + 1;
+  for (int i = 0; i < n; ++i) out.push_back(from + static_cast<float>(i) * step);
+  return out;
+}
+
+SteppedRange parseSteppedRange(const std::string& text, const std::string& what) {
+  SteppedRange r;
+  float a = 0.f, b = 0.f, s = 0.f;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%f:%f:%f%c", &a, &b, &s, &tail) == 3) {
+    r = {a, b, s};
+  } else if (std::sscanf(text.c_str(), "%f%c", &a, &tail) == 1) {
+    r = {a, a, 1.f};
+  } else {
+    throw InputError(fmt::format("{} '{}': expected FROM:TO:STEP or one value", what, text));
+  }
+  if (!std::isfinite(r.from) || !std::isfinite(r.to) || !std::isfinite(r.step) || r.step <= 0.f || r.to < r.from)
+    throw InputError(fmt::format("{} '{}': need FROM <= TO and STEP > 0", what, text));
+  if (r.values().size() > 10000) throw InputError(fmt::format("{} '{}': more than 10000 values", what, text));
+  return r;
+}
+
+void validateViewSampling(const ViewSamplingParams& p) {
+  if (p.viewpoints < 1 || p.viewpoints > 100000)
+    throw InputError(fmt::format("views: {} viewpoints; use 1 to 100000", p.viewpoints));
+  for (float r : p.radii.values())
+    if (!(r >= 0.05f && r <= 6.f)) throw InputError(fmt::format("radii: {} m is outside 0.05 to 6 m", r));
+  for (float a : p.inplane_deg.values())
+    if (!(a >= -180.f && a <= 180.f))
+      throw InputError(fmt::format("in-plane rotation {} degrees is outside -180 to 180", a));
+}
+
+std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere) {
+  // Fibonacci lattice: equal-area bands in z, golden-angle steps in azimuth. On the
+  // hemisphere z runs from 1 (pole) down towards 0, never reaching the horizon exactly.
+  std::vector<Eigen::Vector3f> dirs;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < count; ++i) {
+    const double u = (i + 0.5) / count;
+    const double z = full_sphere ? 1.0 - 2.0 * u : 1.0 - u;
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden * i;
+    dirs.emplace_back(static_cast<float>(rho * std::cos(phi)), static_cast<float>(rho * std::sin(phi)),
+                      static_cast<float>(z));
+  }
+  return dirs;
+}
+
+TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f& centre, float distance,
+                        float inplane_deg) {
+  const Eigen::Vector3f z_cam = -direction.normalized();  // optical axis, in object coordinates
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  if (std::abs(z_cam.dot(up)) > 0.999f) up = Eigen::Vector3f::UnitY();
+  // Camera y points down in the image, so it is minus "up" made orthogonal to the axis.
+  const Eigen::Vector3f y_cam = -(up - up.dot(z_cam) * z_cam).normalized();
+  const Eigen::Vector3f x_cam = y_cam.cross(z_cam);
+  Eigen::Matrix3f R_obj_to_cam;
+  R_obj_to_cam.row(0) = x_cam.transpose();
+  R_obj_to_cam.row(1) = y_cam.transpose();
+  R_obj_to_cam.row(2) = z_cam.transpose();
+  const float a = inplane_deg * static_cast<float>(std::numbers::pi / 180.0);
+  const Eigen::Matrix3f Rz = Eigen::AngleAxisf(a, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  TrainingView v;
+  v.R = Rz * R_obj_to_cam;
+  // The centre lands on the optical axis at `distance`: R * centre + t = (0, 0, distance).
+  v.t = Eigen::Vector3f(0.f, 0.f, distance) - v.R * centre;
+  v.distance = distance;
+  v.inplane_deg = inplane_deg;
+  return v;
+}
+
+std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre) {
+  validateViewSampling(params);
+  const auto dirs = sphereViewpoints(params.viewpoints, params.full_sphere);
+  const auto radii = params.radii.values();
+  const auto angles = params.inplane_deg.values();
+  std::vector<TrainingView> views;
+  views.reserve(dirs.size() * radii.size() * angles.size());
+  for (std::size_t i = 0; i < dirs.size(); ++i)
+    for (float r : radii)
+      for (float a : angles) {
+        auto v = lookAtView(dirs[i], centre, r, a);
+        v.viewpoint = static_cast<int>(i);
+        views.push_back(v);
+      }
+  return views;
+}
+
+}  // namespace vkpose

@@ -1,0 +1,163 @@
+// Mesh loading, exact diameters and view sampling.
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "mesh_support.hpp"
+#include "test_support.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/mesh.hpp"
+#include "vkpose/views.hpp"
+
+#include <Eigen/LU>
+
+namespace vkpose {
+namespace {
+
+const std::string kAssimpModels = "/usr/share/assimp/models";
+
+TEST(ExactDiameter, EqualsBruteForceOnRandomClouds) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g(0.f, 1.f);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<Eigen::Vector3f> pts;
+    for (int i = 0; i < 400; ++i) pts.emplace_back(g(rng), 0.3f * g(rng), 2.f * g(rng));
+    float brute = 0.f;
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      for (std::size_t j = i + 1; j < pts.size(); ++j) brute = std::max(brute, (pts[i] - pts[j]).norm());
+    EXPECT_FLOAT_EQ(exactDiameter(pts), brute);
+  }
+}
+
+TEST(MeshLoading, CoffeeCupInMetres) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  MeshLoadReport report;
+  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Auto, &report);
+  EXPECT_EQ(cup.name, "coffee_cup");
+  EXPECT_TRUE(report.inferred);
+  EXPECT_EQ(report.units, MeshUnits::Metres);
+  EXPECT_NEAR(cup.diameter, 0.137f, 0.002f);  // shared/data/README.md: about 0.137 m
+  EXPECT_GT(cup.faces.size(), 30000u);
+  EXPECT_TRUE(cup.normals.empty()) << "STL facet normals are dropped: the renderer uses face normals";
+  // Identical vertices are joined: a closed surface has about half as many vertices as faces.
+  EXPECT_LT(cup.vertices.size(), cup.faces.size());
+  EXPECT_LT(cup.bboxCentre().norm(), 0.005f);  // origin at the bounding-box centre
+  EXPECT_NE(cup.file_hash, 0u);
+}
+
+TEST(MeshLoading, LmoPlyInMillimetresWithColoursAndNormals) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  MeshLoadReport report;
+  const Mesh ape = loadMesh(test::sharedData() + "/lmo_scene2_frame3/models/obj_000001.ply", MeshUnits::Auto, &report);
+  EXPECT_EQ(report.units, MeshUnits::Millimetres);
+  EXPECT_NEAR(ape.diameter, 0.102099f, 1e-5f);  // models_info.json: 102.099 mm
+  EXPECT_EQ(ape.colours.size(), ape.vertices.size());
+  EXPECT_EQ(ape.normals.size(), ape.vertices.size());
+  EXPECT_NEAR(ape.bbox_min.x(), -0.0379343f, 1e-6f);
+  const Mesh explicit_mm = loadMesh(test::sharedData() + "/lmo_scene2_frame3/models/obj_000001.ply", MeshUnits::Millimetres);
+  EXPECT_FLOAT_EQ(explicit_mm.diameter, ape.diameter);
+}
+
+TEST(MeshLoading, AsciiStlBinaryStlPlyAndObjFromAssimpTestModels) {
+  if (!std::ifstream(kAssimpModels + "/STL/Spider_ascii.stl")) GTEST_SKIP() << "assimp-testmodels is not installed";
+  const Mesh ascii = loadMesh(kAssimpModels + "/STL/Spider_ascii.stl", MeshUnits::Metres);
+  const Mesh binary = loadMesh(kAssimpModels + "/STL/Spider_binary.stl", MeshUnits::Metres);
+  EXPECT_EQ(ascii.faces.size(), binary.faces.size());
+  EXPECT_NEAR(ascii.diameter, binary.diameter, 1e-4f * binary.diameter);
+  const Mesh ply = loadMesh(kAssimpModels + "/PLY/cube.ply", MeshUnits::Metres);
+  EXPECT_EQ(ply.faces.size(), 12u);
+  EXPECT_NEAR(ply.diameter, std::sqrt(3.f), 1e-4f);  // the unit cube's space diagonal
+  const Mesh obj = loadMesh(kAssimpModels + "/OBJ/box.obj", MeshUnits::Metres);
+  EXPECT_EQ(obj.faces.size(), 12u);
+  const Mesh coloured = loadMesh(kAssimpModels + "/OBJ/cube_with_vertexcolors.obj", MeshUnits::Metres);
+  EXPECT_EQ(coloured.colours.size(), coloured.vertices.size());
+}
+
+TEST(MeshLoading, BadFilesGiveClearErrors) {
+  auto expectError = [](const std::string& path, const std::string& words) {
+    try {
+      loadMesh(path, MeshUnits::Metres);
+      ADD_FAILURE() << path << ": expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  expectError("/nonexistent/mesh.stl", "no such mesh file");
+  const std::string dir = ::testing::TempDir();
+  std::ofstream(dir + "/empty.stl").close();
+  expectError(dir + "/empty.stl", "empty");
+  std::ofstream(dir + "/garbage.ply") << "ply\nformat nonsense\n\x01\x02\x03";
+  expectError(dir + "/garbage.ply", "garbage.ply");
+  std::ofstream(dir + "/nofaces.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  expectError(dir + "/nofaces.obj", "nofaces.obj");
+  std::ofstream(dir + "/nan.obj") << "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n";
+  expectError(dir + "/nan.obj", "nan.obj");
+  if (std::ifstream(kAssimpModels + "/OBJ/testpoints.obj")) expectError(kAssimpModels + "/OBJ/testpoints.obj", "testpoints.obj");
+  EXPECT_THROW(parseMeshUnits("cm"), InputError);
+}
+
+TEST(ViewSampling, PaperDefaultsGive14040Views) {
+  const ViewSamplingParams params;
+  const auto views = sampleViews(params, Eigen::Vector3f(0.01f, -0.02f, 0.03f));
+  EXPECT_EQ(views.size(), 216u * 5u * 13u);
+  for (const auto& v : views) {
+    EXPECT_NEAR((v.R * v.R.transpose() - Eigen::Matrix3f::Identity()).norm(), 0.f, 1e-5f);
+    EXPECT_NEAR(v.R.determinant(), 1.f, 1e-5f);
+    // The object's centre is on the optical axis at the training distance.
+    const Eigen::Vector3f c = v.R * Eigen::Vector3f(0.01f, -0.02f, 0.03f) + v.t;
+    EXPECT_NEAR(c.x(), 0.f, 1e-5f);
+    EXPECT_NEAR(c.y(), 0.f, 1e-5f);
+    EXPECT_NEAR(c.z(), v.distance, 1e-5f);
+  }
+  EXPECT_FLOAT_EQ(views.front().distance, 0.6f);
+  EXPECT_FLOAT_EQ(views.front().inplane_deg, -60.f);
+  EXPECT_NEAR(views.back().distance, 1.0f, 1e-5f);
+  EXPECT_FLOAT_EQ(views.back().inplane_deg, 60.f);
+}
+
+TEST(ViewSampling, UpperHemisphereKeepsCamerasAboveAndSpreadsThem) {
+  const auto dirs = sphereViewpoints(216, false);
+  float min_sep = 10.f;
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    EXPECT_GT(dirs[i].z(), 0.f);
+    EXPECT_NEAR(dirs[i].norm(), 1.f, 1e-5f);
+    for (std::size_t j = i + 1; j < dirs.size(); ++j) min_sep = std::min(min_sep, (dirs[i] - dirs[j]).norm());
+  }
+  // 216 points on a hemisphere (area 2 pi): mean spacing about sqrt(2 pi / 216) = 0.17.
+  EXPECT_GT(min_sep, 0.08f);
+  const auto full = sphereViewpoints(100, true);
+  int below = 0;
+  for (const auto& d : full) below += d.z() < 0.f;
+  EXPECT_EQ(below, 50);
+}
+
+TEST(ViewSampling, ImageUpIsTheObjectsUpAndInplaneRotatesAboutTheAxis) {
+  const TrainingView side = lookAtView({1.f, 0.f, 0.f}, Eigen::Vector3f::Zero(), 0.8f, 0.f);
+  // Object +z points to image -y (up) for a camera level with the object.
+  const Eigen::Vector3f up_cam = side.R * Eigen::Vector3f::UnitZ();
+  EXPECT_NEAR(up_cam.y(), -1.f, 1e-5f);
+  const TrainingView turned = lookAtView({1.f, 0.f, 0.f}, Eigen::Vector3f::Zero(), 0.8f, 30.f);
+  const Eigen::Vector3f up_turned = turned.R * Eigen::Vector3f::UnitZ();
+  EXPECT_NEAR(std::atan2(up_turned.x(), -up_turned.y()), 30.f * 3.14159265f / 180.f, 1e-4f);
+  const TrainingView pole = lookAtView({0.f, 0.f, 1.f}, Eigen::Vector3f::Zero(), 0.8f, 0.f);
+  EXPECT_TRUE(pole.R.allFinite());
+}
+
+TEST(ViewSampling, RangesParseAndRejectNonsense) {
+  EXPECT_EQ(parseSteppedRange("0.6:1.0:0.1", "radii").values().size(), 5u);
+  EXPECT_EQ(parseSteppedRange("-60:60:10", "inplane").values().size(), 13u);
+  EXPECT_EQ(parseSteppedRange("0.7", "radii").values().size(), 1u);
+  EXPECT_THROW(parseSteppedRange("1:0:0.1", "radii"), InputError);
+  EXPECT_THROW(parseSteppedRange("0:1:0", "radii"), InputError);
+  EXPECT_THROW(parseSteppedRange("a:b", "radii"), InputError);
+  ViewSamplingParams p;
+  p.radii = {0.f, 0.f, 1.f};
+  EXPECT_THROW(validateViewSampling(p), InputError);
+  p = {};
+  p.viewpoints = 0;
+  EXPECT_THROW(validateViewSampling(p), InputError);
+}
+
+}  // namespace
+}  // namespace vkpose
