@@ -104,7 +104,7 @@ TEST(Render, BoxDepthEqualsRayCasting) {
   const Camera cam = smallCamera();
   const Pose pose = viewPose({0.4f, -0.6f, 0.7f}, 0.55f, 15.f);
   const Rendering r = renderer.render(cam, {pose})[0];
-  int checked = 0, disagree = 0;
+  int checked = 0, disagree = 0, exact = 0;
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
       const float expected = rayCastBox(cam, pose, 0.5f * size, x, y);
@@ -116,11 +116,15 @@ TEST(Render, BoxDepthEqualsRayCasting) {
         continue;
       }
       if (expected > 0) {
-        EXPECT_NEAR(got, expected, 2e-6f) << "pixel " << x << "," << y;
+        // Pixels next to an edge between two faces may be given to the neighbouring face
+        // (snapping): within 0.1 mm there; exact up to float rounding everywhere else.
+        EXPECT_NEAR(got, expected, 1e-4f) << "pixel " << x << "," << y;
+        exact += std::abs(got - expected) <= 2e-6f;
         ++checked;
       }
     }
   EXPECT_GT(checked, 3000);
+  EXPECT_GT(exact, checked * 98 / 100);
   EXPECT_LT(disagree, checked / 100);
 }
 
