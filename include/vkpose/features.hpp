@@ -57,8 +57,9 @@ int gradientOrientationBin(int gx, int gy);
 
 /// Sobel per channel of the smoothed image, strongest channel, orientation bin, 3x3
 /// majority vote (>= 5 of 9) among pixels whose squared magnitude exceeds weak^2.
-/// Output: CV_8UC1 label image (1 << bin, or 0).
-cv::Mat quantizeColourGradients(const cv::Mat& bgr, float weak_threshold);
+/// Output: CV_8UC1 label image (1 << bin, or 0). `magnitude_sq`, when given, receives the
+/// squared gradient magnitude of the strongest channel (CV_32SC1), which training ranks by.
+cv::Mat quantizeColourGradients(const cv::Mat& bgr, float weak_threshold, cv::Mat* magnitude_sq = nullptr);
 
 /// Next pyramid level of the colour image: 5x5 binomial, every second pixel, reflected
 /// border (bit-exact with cv::pyrDown to (cols / 2, rows / 2)).

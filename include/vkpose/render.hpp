@@ -34,6 +34,11 @@ struct Rendering {
 /// arithmetic as the GPU kernels (shaders/raster_*.comp).
 Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& pose);
 
+/// The rendering a camera rotated by `degrees` about its optical axis would see: for square
+/// pixels (fx = fy) that is the image rotated about the principal point (cx, cy), with
+/// normals rotated alike. Nearest-neighbour resampling, so depth values stay exact.
+Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy);
+
 /// Renders a mesh on the GPU. The mesh stays on the device; render() splits the views into
 /// batches that fit the device's buffer limits, one submit per batch.
 class MeshRenderer {

@@ -27,5 +27,6 @@ using Runner = std::function<int()>;
 Runner addInfoCommand(CLI::App& app, const GlobalOptions& global);
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDemoCommand(CLI::App& app, const GlobalOptions& global);
+Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vkpose::cli

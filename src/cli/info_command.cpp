@@ -1,15 +1,45 @@
 // `vkpose info`: the Vulkan devices, the one vkpose would choose, and the limits that matter.
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/template_bank.hpp"
 
 namespace vkpose::cli {
 
+namespace {
+void printBankSummary(const TemplateBank& bank, const std::string& path) {
+  const auto& p = bank.params;
+  std::size_t features = 0;
+  for (const auto& t : bank.templates)
+    for (const auto& l : t.linemod.levels) features += l.features.size();
+  fmt::print("bank: {}\n", path);
+  fmt::print("object: {}\n", bank.object);
+  fmt::print("mesh hash: {:016x}\n", bank.mesh_hash);
+  fmt::print("diameter: {:.4f} m\n", bank.diameter);
+  fmt::print("symmetric: {}\n", bank.symmetric ? "yes" : "no");
+  fmt::print("templates: {}\n", bank.templates.size());
+  fmt::print("views: {} viewpoints ({}), radii {}:{}:{} m, in-plane {}:{}:{} deg\n", p.views.viewpoints,
+             p.views.full_sphere ? "full sphere" : "upper hemisphere", p.views.radii.from, p.views.radii.to,
+             p.views.radii.step, p.views.inplane_deg.from, p.views.inplane_deg.to, p.views.inplane_deg.step);
+  fmt::print("features: {} per modality and level, T = {}, modalities {}{}, {:.1f} per template\n",
+             p.features_per_modality, fmt::join(p.features.T, ","), p.features.use_colour ? "colour " : "",
+             p.features.use_depth ? "depth" : "",
+             bank.templates.empty() ? 0.0 : static_cast<double>(features) / static_cast<double>(bank.templates.size()));
+  fmt::print("camera: fx {:.2f} fy {:.2f}\n", p.camera.fx, p.camera.fy);
+}
+}  // namespace
+
 Runner addInfoCommand(CLI::App& app, const GlobalOptions& global) {
-  auto* sub = app.add_subcommand("info", "List Vulkan devices, the chosen one and its limits");
-  (void)sub;
-  return [&global]() {
+  auto* sub = app.add_subcommand("info", "List Vulkan devices, the chosen one and its limits; or describe a bank");
+  auto bank_path = std::make_shared<std::string>();
+  sub->add_option("--bank", *bank_path, "Describe this template bank instead (no device needed)");
+  return [&global, bank_path]() {
+    if (!bank_path->empty()) {
+      printBankSummary(loadBank(*bank_path), *bank_path);
+      return 0;
+    }
     const auto devices = listGpuDevices();
     if (devices.empty()) throw DeviceError("no Vulkan device found: apt-get install mesa-vulkan-drivers (lavapipe)");
     const std::size_t chosen = chooseGpuDevice(devices, global.gpu());

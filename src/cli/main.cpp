@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
       if (std::find(before.begin(), before.end(), sub) == before.end()) runners[sub] = r;
   };
   add(addInfoCommand);
+  add(addTrainCommand);
   add(addBenchCommand);
   add(addDemoCommand);
 

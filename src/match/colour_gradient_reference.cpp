@@ -58,7 +58,7 @@ int gradientOrientationBin(int gx, int gy) {
   return gx >= 0 ? b : (8 - b) & 7;
 }
 
-cv::Mat quantizeColourGradients(const cv::Mat& bgr, float weak_threshold) {
+cv::Mat quantizeColourGradients(const cv::Mat& bgr, float weak_threshold, cv::Mat* magnitude_sq) {
   const cv::Mat smoothed = gaussianBlur7(bgr);
   const int w = bgr.cols, h = bgr.rows;
   cv::Mat raw_bins = cv::Mat::zeros(h, w, CV_8UC1);
@@ -100,6 +100,7 @@ cv::Mat quantizeColourGradients(const cv::Mat& bgr, float weak_threshold) {
         if (histogram[i] > histogram[best]) best = i;
       if (histogram[best] >= 5) labels.at<uint8_t>(y, x) = static_cast<uint8_t>(1u << best);
     }
+  if (magnitude_sq) *magnitude_sq = magnitude;
   return labels;
 }
 

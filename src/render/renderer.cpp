@@ -108,6 +108,28 @@ Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& po
   return out;
 }
 
+Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy) {
+  if (degrees == 0.f) return {r.depth.clone(), r.normals.clone(), r.bgr.clone()};
+  const double a = degrees * CV_PI / 180.0, c = std::cos(a), s = std::sin(a);
+  // Camera-frame points turn by Rz(a), so image offsets from the principal point turn by the
+  // same 2D rotation; warpAffine with this forward map samples the source for each output.
+  const cv::Matx23d forward(c, -s, cx - c * cx + s * cy, s, c, cy - s * cx - c * cy);
+  Rendering out;
+  const cv::Size size = r.depth.size();
+  cv::warpAffine(r.depth, out.depth, forward, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::warpAffine(r.bgr, out.bgr, forward, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::Mat normals;
+  cv::warpAffine(r.normals, normals, forward, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  out.normals.create(size, CV_32FC3);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const cv::Vec3f n = normals.at<cv::Vec3f>(y, x);
+      out.normals.at<cv::Vec3f>(y, x) = {static_cast<float>(c * n[0] - s * n[1]), static_cast<float>(s * n[0] + c * n[1]),
+                                         n[2]};
+    }
+  return out;
+}
+
 // ---- GPU --------------------------------------------------------------------------------
 
 namespace {

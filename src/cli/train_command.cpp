@@ -1,0 +1,99 @@
+// `vkpose train MESH --out BANK`: render the mesh from every training view and store the
+// LINEMOD templates in a bank file.
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
+#include "gpu/batch.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/template_bank.hpp"
+
+namespace vkpose::cli {
+
+namespace {
+struct TrainOptions {
+  std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera;
+  int views = 216, features = 63;
+  bool symmetric = false, force = false;
+};
+
+const char* unitName(MeshUnits u) { return u == MeshUnits::Millimetres ? "millimetres" : "metres"; }
+
+TrainingParams trainingParamsFrom(const TrainOptions& o) {
+  TrainingParams p;
+  p.views.viewpoints = o.views;
+  p.views.radii = parseSteppedRange(o.radii, "--radii");
+  p.views.inplane_deg = parseSteppedRange(o.inplane, "--inplane");
+  p.views.full_sphere = o.hemisphere == "full";
+  p.features_per_modality = o.features;
+  p.symmetric = o.symmetric;
+  if (!o.camera.empty()) p.camera = loadCamera(o.camera);
+  validateTrainingParams(p);
+  return p;
+}
+}  // namespace
+
+Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<TrainOptions>();
+  auto* sub = app.add_subcommand("train", "Render a mesh from many views and write its LINEMOD template bank");
+  sub->add_option("mesh", opt->mesh, "Mesh file: STL (binary or ASCII), PLY (colours kept) or OBJ")->required();
+  sub->add_option("-o,--out", opt->out, "Template bank to write (.vkpb); never overwritten without --force")->required();
+  sub->add_option("--units", opt->units, "Mesh units: mm, m, or auto (from the object's size)")
+      ->check(CLI::IsMember({"mm", "m", "auto"}))
+      ->capture_default_str();
+  sub->add_option("--views", opt->views, "Viewpoints on the (hemi)sphere (Fibonacci lattice)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  sub->add_option("--radii", opt->radii, "Camera distances FROM:TO:STEP, metres")->capture_default_str();
+  sub->add_option("--inplane", opt->inplane, "In-plane rotations FROM:TO:STEP, degrees")->capture_default_str();
+  sub->add_option("--hemisphere", opt->hemisphere, "Viewpoints on the upper hemisphere or the full sphere")
+      ->check(CLI::IsMember({"upper", "full"}))
+      ->capture_default_str();
+  sub->add_option("--features", opt->features, "Features per modality and pyramid level (LINEMOD: 63)")
+      ->check(CLI::Range(4, 4096))
+      ->capture_default_str();
+  sub->add_option("--camera", opt->camera, "BOP camera.json of the sensor (focal lengths); default: LINEMOD's Kinect");
+  sub->add_flag("--symmetric", opt->symmetric, "The object is symmetric (evaluation scores it with ADI)");
+  sub->add_flag("--force", opt->force, "Overwrite --out if it exists");
+  return [opt, &global]() {
+    const TrainingParams params = trainingParamsFrom(*opt);
+    if (std::filesystem::exists(opt->out) && !opt->force)
+      throw InputError(fmt::format("{} exists: pass --force to overwrite it", opt->out));
+    MeshLoadReport report;
+    const Mesh mesh = loadMesh(opt->mesh, parseMeshUnits(opt->units), &report);
+    if (!global.quiet) {
+      fmt::print("mesh: {} ({} triangles, {} vertices{}{})\n", mesh.name, mesh.faces.size(), mesh.vertices.size(),
+                 mesh.colours.empty() ? "" : ", vertex colours", mesh.normals.empty() ? "" : ", normals");
+      if (report.inferred)
+        fmt::print("units: {} (inferred: the file's diameter is {:.4g} units; pass --units to override)\n",
+                   unitName(report.units), report.file_diameter);
+      fmt::print("diameter: {:.4f} m\n", mesh.diameter);
+    }
+    GpuContext ctx(global.gpu());
+    ProgressBar bar("training", global.quiet);
+    TrainingTimings timings;
+    const TemplateBank bank =
+        trainTemplates(ctx, mesh, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); },
+                       &timings);
+    bar.finish();
+    saveBank(bank, opt->out);
+    const auto bytes = std::filesystem::file_size(opt->out);
+    fmt::print("templates: {}\n", bank.templates.size());
+    if (!global.quiet) {
+      if (timings.dropped) fmt::print("dropped: {} views with too few features\n", timings.dropped);
+      fmt::print("time: {:.1f} s (render {:.1f} s, features {:.1f} s) on {}, {:.0f} templates/s\n",
+                 timings.total_ms / 1e3, timings.render_ms / 1e3, timings.features_ms / 1e3, ctx.device().name,
+                 1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
+      fmt::print("bank: {} ({:.1f} MiB)\n", opt->out, static_cast<double>(bytes) / (1 << 20));
+    }
+    if (!gpu::kernelProfile().empty()) {
+      fmt::print("per kernel (VKPOSE_PROFILE_KERNELS):\n");
+      for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
+    }
+    return kOk;
+  };
+}
+
+}  // namespace vkpose::cli

@@ -1,0 +1,337 @@
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "util/parallel.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/template_bank.hpp"
+
+namespace vkpose {
+
+void validateTrainingParams(const TrainingParams& p) {
+  validateViewSampling(p.views);
+  validateFeatureParams(p.features);
+  validateCamera(p.camera, "training camera");
+  if (p.features_per_modality < 4 || p.features_per_modality > 4096)
+    throw InputError(fmt::format("features: {} per modality; use 4 to 4096", p.features_per_modality));
+  if (!(p.strong_threshold > 0.f && p.strong_threshold < 2000.f))
+    throw InputError(fmt::format("strong threshold {} must be in (0, 2000)", p.strong_threshold));
+}
+
+std::vector<LinemodTemplate> TemplateBank::linemodTemplates() const {
+  std::vector<LinemodTemplate> out;
+  out.reserve(templates.size());
+  for (const auto& t : templates) out.push_back(t.linemod);
+  return out;
+}
+
+namespace {
+
+struct Candidate {
+  int x = 0, y = 0;
+  uint8_t bin = 0;
+  float score = 0.f;
+};
+
+/// LINEMOD's scattered selection: best first, each new feature at least `distance` from
+/// those already taken; the distance relaxes by one pixel after every pass.
+std::vector<Candidate> selectScattered(std::vector<Candidate> candidates, int count) {
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  if (static_cast<int>(candidates.size()) <= count) return candidates;
+  std::vector<Candidate> chosen;
+  std::vector<bool> taken(candidates.size(), false);
+  float distance = static_cast<float>(candidates.size() / static_cast<std::size_t>(count) + 1);
+  while (static_cast<int>(chosen.size()) < count) {
+    const float d2 = distance * distance;
+    for (std::size_t i = 0; i < candidates.size() && static_cast<int>(chosen.size()) < count; ++i) {
+      if (taken[i]) continue;
+      bool keep = true;
+      for (const auto& f : chosen) {
+        const float dx = static_cast<float>(candidates[i].x - f.x), dy = static_cast<float>(candidates[i].y - f.y);
+        if (dx * dx + dy * dy < d2) {
+          keep = false;
+          break;
+        }
+      }
+      if (keep) {
+        chosen.push_back(candidates[i]);
+        taken[i] = true;
+      }
+    }
+    distance -= 1.f;  // at distance 1 every untaken candidate qualifies, so this ends
+  }
+  return chosen;
+}
+
+/// Colour candidates: gradient labels on or next to the object (silhouette and inner edges)
+/// whose magnitude is a 5x5 local maximum above the strong threshold.
+std::vector<Candidate> colourCandidates(const cv::Mat& labels, const cv::Mat& magnitude_sq, const cv::Mat& mask,
+                                        float strong_threshold) {
+  cv::Mat region;
+  cv::dilate(mask, region, cv::Mat());
+  const float strong_sq = strong_threshold * strong_threshold;
+  std::vector<Candidate> out;
+  for (int y = 2; y < labels.rows - 2; ++y)
+    for (int x = 2; x < labels.cols - 2; ++x) {
+      const uint8_t label = labels.at<uint8_t>(y, x);
+      const int32_t m = magnitude_sq.at<int32_t>(y, x);
+      if (!label || !region.at<uint8_t>(y, x) || !(static_cast<float>(m) > strong_sq)) continue;
+      bool is_max = true;
+      // Strict maximum, ties going to the earlier pixel in raster order.
+      for (int dy = -2; dy <= 2 && is_max; ++dy)
+        for (int dx = -2; dx <= 2 && is_max; ++dx) {
+          if (!dx && !dy) continue;
+          const int32_t n = magnitude_sq.at<int32_t>(y + dy, x + dx);
+          const bool earlier = dy < 0 || (dy == 0 && dx < 0);
+          if (n > m || (n == m && earlier)) is_max = false;
+        }
+      if (is_max) out.push_back({x, y, static_cast<uint8_t>(std::countr_zero(label)), std::sqrt(static_cast<float>(m))});
+    }
+  return out;
+}
+
+/// Depth candidates: normal labels inside the mask eroded twice (away from the silhouette's
+/// unreliable normals), scored by the distance to the nearest change of label, so features
+/// sit in the middle of uniformly oriented surfaces.
+std::vector<Candidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mask) {
+  cv::Mat region;
+  cv::erode(mask, region, cv::Mat(), cv::Point(-1, -1), 2);
+  cv::Mat uniform = cv::Mat::zeros(labels.size(), CV_8UC1);
+  for (int y = 1; y < labels.rows - 1; ++y)
+    for (int x = 1; x < labels.cols - 1; ++x) {
+      const uint8_t l = labels.at<uint8_t>(y, x);
+      if (!l || !region.at<uint8_t>(y, x)) continue;
+      const bool same = labels.at<uint8_t>(y - 1, x) == l && labels.at<uint8_t>(y + 1, x) == l &&
+                        labels.at<uint8_t>(y, x - 1) == l && labels.at<uint8_t>(y, x + 1) == l;
+      uniform.at<uint8_t>(y, x) = same ? 255 : 0;
+    }
+  cv::Mat distance;
+  cv::distanceTransform(uniform, distance, cv::DIST_L2, 3);
+  std::vector<Candidate> out;
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x) {
+      const uint8_t l = labels.at<uint8_t>(y, x);
+      if (l && region.at<uint8_t>(y, x))
+        out.push_back({x, y, static_cast<uint8_t>(std::countr_zero(l)), distance.at<float>(y, x)});
+    }
+  return out;
+}
+
+/// Nearest-neighbour halving, the same pixels as downsampleLabels keeps.
+cv::Mat halveMask(const cv::Mat& mask) { return downsampleLabels(mask); }
+
+}  // namespace
+
+ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& params) {
+  const FeatureParams& fp = params.features;
+  const std::size_t levels = fp.T.size();
+  // Work on the object's box plus a margin that covers every filter's reach (blur, Sobel,
+  // vote, normals, median, non-maximum suppression) at every level; its origin is a
+  // multiple of 2^levels so the pyramid samples the same pixels as on the whole tile.
+  const cv::Rect object = cv::boundingRect(full.mask());
+  if (object.empty()) return {};
+  const int align = 1 << levels, margin = 16 << (levels - 1);
+  const int x0 = std::max(0, (object.x - margin) / align * align), y0 = std::max(0, (object.y - margin) / align * align);
+  const int x1 = std::min(full.depth.cols, object.br().x + margin), y1 = std::min(full.depth.rows, object.br().y + margin);
+  const cv::Rect roi(x0, y0, x1 - x0, y1 - y0);
+  const Rendering r{full.depth(roi), full.normals(roi), full.bgr(roi)};
+  cv::Mat depth_mm;
+  r.depth.convertTo(depth_mm, CV_16U, 1000.0);
+  cv::Mat mask = r.mask();
+  cv::Mat bgr = r.bgr;
+  cv::Mat depth_labels;
+  std::vector<std::vector<Candidate>> chosen[kModalityCount];
+  for (auto& c : chosen) c.resize(levels);
+  for (std::size_t l = 0; l < levels; ++l) {
+    if (l > 0) {
+      mask = halveMask(mask);
+      if (fp.use_colour) bgr = pyrDownColour(bgr);
+    }
+    if (fp.use_colour) {
+      cv::Mat magnitude;
+      const cv::Mat labels = quantizeColourGradients(bgr, fp.weak_threshold, &magnitude);
+      chosen[0][l] = selectScattered(colourCandidates(labels, magnitude, mask, params.strong_threshold),
+                                     params.features_per_modality);
+    }
+    if (fp.use_depth) {
+      depth_labels = l == 0 ? quantizeDepthNormals(depth_mm, fp.distance_threshold_mm, fp.difference_threshold_mm)
+                            : downsampleLabels(depth_labels);
+      chosen[1][l] = selectScattered(depthCandidates(depth_labels, mask), params.features_per_modality);
+    }
+  }
+  ExtractedTemplate out;
+  // The template's box over all levels and modalities, in level-0 pixels (even origin, so
+  // every level's origin is a whole pixel), as OpenCV's cropTemplates.
+  int min_x = INT32_MAX, min_y = INT32_MAX, max_x = INT32_MIN, max_y = INT32_MIN;
+  for (int m = 0; m < kModalityCount; ++m)
+    for (std::size_t l = 0; l < levels; ++l) {
+      const bool on = m == 0 ? fp.use_colour : fp.use_depth;
+      if (on && chosen[m][l].size() < 4) return out;  // too little of the object to match
+      for (const auto& c : chosen[m][l]) {
+        min_x = std::min(min_x, c.x << l);
+        min_y = std::min(min_y, c.y << l);
+        max_x = std::max(max_x, c.x << l);
+        max_y = std::max(max_y, c.y << l);
+      }
+    }
+  if (min_x == INT32_MAX) return out;
+  min_x -= min_x % 2;
+  min_y -= min_y % 2;
+  out.linemod.levels.resize(levels);
+  for (std::size_t l = 0; l < levels; ++l) {
+    auto& level = out.linemod.levels[l];
+    level.width = (max_x - min_x) >> l;
+    level.height = (max_y - min_y) >> l;
+    for (int m = 0; m < kModalityCount; ++m)
+      for (const auto& c : chosen[m][l])
+        level.features.push_back({c.x - (min_x >> l), c.y - (min_y >> l), c.bin, static_cast<Modality>(m)});
+  }
+  out.origin_x = min_x + x0;
+  out.origin_y = min_y + y0;
+  out.ok = true;
+  return out;
+}
+
+namespace {
+
+TemplateCrop cropRendering(const Rendering& r, int origin_x, int origin_y, int width, int height) {
+  TemplateCrop crop;
+  crop.stride = std::max(1, (std::max(width, height) + kCropCells - 1) / kCropCells);
+  crop.cols = width / crop.stride + 1;
+  crop.rows = height / crop.stride + 1;
+  crop.depth_01mm.assign(static_cast<std::size_t>(crop.cols) * crop.rows, 0);
+  crop.normals.assign(static_cast<std::size_t>(crop.cols) * crop.rows * 3, 0);
+  for (int i = 0; i < crop.rows; ++i)
+    for (int j = 0; j < crop.cols; ++j) {
+      const int x = origin_x + j * crop.stride, y = origin_y + i * crop.stride;
+      if (x < 0 || y < 0 || x >= r.depth.cols || y >= r.depth.rows) continue;
+      const float z = r.depth.at<float>(y, x);
+      if (!(z > 0.f)) continue;
+      const std::size_t k = static_cast<std::size_t>(i) * crop.cols + j;
+      crop.depth_01mm[k] = static_cast<uint16_t>(std::clamp(std::lround(z * 1e4f), 1l, 65535l));
+      const cv::Vec3f n = r.normals.at<cv::Vec3f>(y, x);
+      for (int c = 0; c < 3; ++c) crop.normals[3 * k + c] = static_cast<int8_t>(std::lround(std::clamp(n[c], -1.f, 1.f) * 127.f));
+    }
+  return crop;
+}
+
+/// The square render tile that holds the object from every training view, with the
+/// object's centre at pixel (half, half), plus a margin for the feature filters.
+Camera trainingTile(const Mesh& mesh, const TrainingParams& params) {
+  float bound = 0.f;
+  const Eigen::Vector3f centre = mesh.bboxCentre();
+  for (const auto& v : mesh.vertices) bound = std::max(bound, (v - centre).norm());
+  const auto radii = params.views.radii.values();
+  const float nearest = *std::min_element(radii.begin(), radii.end());
+  if (!(nearest > 1.1f * bound))
+    throw InputError(fmt::format("training distance {} m is too close for '{}' (it reaches {:.3f} m from its centre)",
+                                 nearest, mesh.name, bound));
+  const double f = 0.5 * (params.camera.fx + params.camera.fy);
+  // Half-angle of the tangent cone around the bounding sphere, projected.
+  const int half = static_cast<int>(std::ceil(f * bound / std::sqrt(nearest * nearest - bound * bound))) + 12;
+  // Square pixels (the mean focal length) make in-plane rotations exact image rotations.
+  Camera tile = params.camera;
+  tile.fx = tile.fy = 0.5 * (params.camera.fx + params.camera.fy);
+  tile.cx = tile.cy = half;
+  tile.width = tile.height = 2 * half + 2;
+  if (tile.width > 4096)
+    throw InputError(fmt::format("'{}' would render {} pixels wide at {} m: train from further away", mesh.name,
+                                 tile.width, nearest));
+  return tile;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                            const TrainingProgress& progress, TrainingTimings* timings) {
+  const auto t_start = std::chrono::steady_clock::now();
+  validateTrainingParams(params);
+  if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles", mesh.name));
+  TemplateBank bank;
+  bank.object = mesh.name;
+  bank.mesh_hash = mesh.file_hash;
+  bank.diameter = mesh.diameter;
+  bank.symmetric = params.symmetric;
+  bank.centre = mesh.bboxCentre();
+  bank.params = params;
+  const Camera tile = trainingTile(mesh, params);
+  const auto views = sampleViews(params.views, bank.centre);
+  // Views differing only by in-plane rotation share one rendering: the GPU renders each
+  // (viewpoint, distance) once and the rotations are image rotations of it (exact for a
+  // pinhole camera with square pixels, up to nearest-neighbour resampling).
+  std::vector<std::size_t> base_of(views.size());
+  std::vector<Pose> bases;
+  std::vector<std::vector<std::size_t>> members;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (i == 0 || views[i].viewpoint != views[i - 1].viewpoint || views[i].distance != views[i - 1].distance) {
+      const float a = -views[i].inplane_deg * static_cast<float>(CV_PI / 180.0);
+      const Eigen::Matrix3f undo = Eigen::AngleAxisf(a, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+      bases.push_back({undo * views[i].R, undo * views[i].t});
+      members.emplace_back();
+    }
+    members.back().push_back(i);
+  }
+  MeshRenderer renderer(ctx, mesh);
+  const std::size_t per_batch = std::min<std::size_t>(renderer.viewsPerBatch(tile), 32);
+  TrainingTimings t;
+  std::size_t done = 0;
+  for (std::size_t first = 0; first < bases.size(); first += per_batch) {
+    const std::size_t n = std::min(per_batch, bases.size() - first);
+    auto t0 = std::chrono::steady_clock::now();
+    const auto renders = renderer.render(tile, std::vector<Pose>(bases.begin() + first, bases.begin() + first + n));
+    t.render_ms += msSince(t0);
+    t0 = std::chrono::steady_clock::now();
+    std::vector<std::size_t> todo;
+    std::vector<std::size_t> render_of;
+    for (std::size_t b = first; b < first + n; ++b)
+      for (std::size_t v : members[b]) {
+        todo.push_back(v);
+        render_of.push_back(b - first);
+      }
+    std::vector<BankTemplate> made(todo.size());
+    std::vector<char> ok(todo.size(), 0);
+    util::parallelFor(todo.size(), [&](std::size_t i) {
+      const TrainingView& v = views[todo[i]];
+      const Rendering view = rotateInPlane(renders[render_of[i]], v.inplane_deg, tile.cx, tile.cy);
+      const ExtractedTemplate e = extractTemplate(view, params);
+      if (!e.ok) return;
+      BankTemplate& bt = made[i];
+      bt.linemod = e.linemod;
+      bt.pose = {v.R, v.t};
+      bt.distance = v.distance;
+      bt.inplane_deg = v.inplane_deg;
+      bt.viewpoint = v.viewpoint;
+      bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
+      bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
+      bt.crop = cropRendering(view, e.origin_x, e.origin_y, e.linemod.levels[0].width, e.linemod.levels[0].height);
+      ok[i] = 1;
+    });
+    for (std::size_t i = 0; i < todo.size(); ++i) {
+      if (ok[i])
+        bank.templates.push_back(std::move(made[i]));
+      else
+        ++t.dropped;
+    }
+    t.features_ms += msSince(t0);
+    done += todo.size();
+    if (progress) progress(done, views.size());
+  }
+  if (bank.templates.empty())
+    throw InputError(fmt::format("no view of '{}' gave enough features for a template (is the mesh visible at {} m?)",
+                                 mesh.name, params.views.radii.from));
+  t.total_ms = msSince(t_start);
+  if (timings) *timings = t;
+  return bank;
+}
+
+}  // namespace vkpose
