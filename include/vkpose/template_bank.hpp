@@ -34,9 +34,11 @@ struct TrainingParams {
 /// Throws InputError naming the bad value.
 void validateTrainingParams(const TrainingParams& params);
 
-/// Depth and normals of a rendered template, sampled every `stride` pixels over the
-/// template's level-0 box (cell (i, j) = template pixel (j * stride, i * stride)).
+/// Depth and normals of a rendered template, sampled every `stride` pixels over the object's
+/// box: cell (i, j) is template pixel (x0 + j * stride, y0 + i * stride) (level 0, relative
+/// to the template's top-left corner; x0, y0 <= 0 when the object reaches past the features).
 struct TemplateCrop {
+  int x0 = 0, y0 = 0;
   int stride = 1;
   int cols = 0, rows = 0;
   std::vector<uint16_t> depth_01mm;  ///< depth in 0.1 mm units, 0 = not the object
@@ -85,6 +87,12 @@ struct TrainingTimings {
 /// eroded mask (centres of uniform regions first), spread out over the object.
 TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
                             const TrainingProgress& progress = {}, TrainingTimings* timings = nullptr);
+
+/// The same for an explicit list of views (e.g. a subset of sampleViews()); views that differ
+/// only in in-plane rotation must be consecutive to share a rendering.
+TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                                     const std::vector<TrainingView>& views, const TrainingProgress& progress = {},
+                                     TrainingTimings* timings = nullptr);
 
 /// The features of one rendering (tile pixels) as a template; `ok` false when a modality
 /// that is on has fewer than 4 features at some level.

@@ -137,6 +137,8 @@ void writePayload(Writer& w, const TemplateBank& bank) {
         w.put(static_cast<uint8_t>(f.modality));
       }
     }
+    w.put(static_cast<int32_t>(t.crop.x0));
+    w.put(static_cast<int32_t>(t.crop.y0));
     w.put(static_cast<int32_t>(t.crop.stride));
     w.put(static_cast<int32_t>(t.crop.cols));
     w.put(static_cast<int32_t>(t.crop.rows));
@@ -209,6 +211,8 @@ TemplateBank readPayload(Reader& r, const std::string& path) {
         f.modality = static_cast<Modality>(m);
       }
     }
+    t.crop.x0 = r.get<int32_t>();
+    t.crop.y0 = r.get<int32_t>();
     t.crop.stride = r.get<int32_t>();
     t.crop.cols = r.get<int32_t>();
     t.crop.rows = r.get<int32_t>();
@@ -264,6 +268,7 @@ TemplateBank loadBank(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(fmt::format("{}: no such template bank", path));
   std::ifstream in(path, std::ios::binary);
   std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.empty()) throw InputError(fmt::format("{}: empty file, not a vkpose template bank", path));
   if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 8) != 0) {
     if (bytes.size() < 8 && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0)
       throw InputError(fmt::format("{}: truncated template bank ({} bytes)", path, bytes.size()));

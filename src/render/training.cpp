@@ -200,8 +200,13 @@ ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& p
 
 namespace {
 
-TemplateCrop cropRendering(const Rendering& r, int origin_x, int origin_y, int width, int height) {
+/// The crop of the object's box, positioned relative to the template's origin.
+TemplateCrop cropRendering(const Rendering& r, int template_x, int template_y) {
+  const cv::Rect box = cv::boundingRect(r.mask());
+  const int origin_x = box.x, origin_y = box.y, width = box.width - 1, height = box.height - 1;
   TemplateCrop crop;
+  crop.x0 = origin_x - template_x;
+  crop.y0 = origin_y - template_y;
   crop.stride = std::max(1, (std::max(width, height) + kCropCells - 1) / kCropCells);
   crop.cols = width / crop.stride + 1;
   crop.rows = height / crop.stride + 1;
@@ -223,12 +228,12 @@ TemplateCrop cropRendering(const Rendering& r, int origin_x, int origin_y, int w
 
 /// The square render tile that holds the object from every training view, with the
 /// object's centre at pixel (half, half), plus a margin for the feature filters.
-Camera trainingTile(const Mesh& mesh, const TrainingParams& params) {
+Camera trainingTile(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views) {
   float bound = 0.f;
   const Eigen::Vector3f centre = mesh.bboxCentre();
   for (const auto& v : mesh.vertices) bound = std::max(bound, (v - centre).norm());
-  const auto radii = params.views.radii.values();
-  const float nearest = *std::min_element(radii.begin(), radii.end());
+  float nearest = views.front().distance;
+  for (const auto& v : views) nearest = std::min(nearest, v.distance);
   if (!(nearest > 1.1f * bound))
     throw InputError(fmt::format("training distance {} m is too close for '{}' (it reaches {:.3f} m from its centre)",
                                  nearest, mesh.name, bound));
@@ -254,9 +259,17 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 
 TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
                             const TrainingProgress& progress, TrainingTimings* timings) {
+  validateTrainingParams(params);
+  return trainTemplatesFromViews(ctx, mesh, params, sampleViews(params.views, mesh.bboxCentre()), progress, timings);
+}
+
+TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                                     const std::vector<TrainingView>& views, const TrainingProgress& progress,
+                                     TrainingTimings* timings) {
   const auto t_start = std::chrono::steady_clock::now();
   validateTrainingParams(params);
   if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles", mesh.name));
+  if (views.empty()) throw InputError("no training views");
   TemplateBank bank;
   bank.object = mesh.name;
   bank.mesh_hash = mesh.file_hash;
@@ -264,8 +277,7 @@ TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const Train
   bank.symmetric = params.symmetric;
   bank.centre = mesh.bboxCentre();
   bank.params = params;
-  const Camera tile = trainingTile(mesh, params);
-  const auto views = sampleViews(params.views, bank.centre);
+  const Camera tile = trainingTile(mesh, params, views);
   // Views differing only by in-plane rotation share one rendering: the GPU renders each
   // (viewpoint, distance) once and the rotations are image rotations of it (exact for a
   // pinhole camera with square pixels, up to nearest-neighbour resampling).
@@ -313,7 +325,7 @@ TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const Train
       bt.viewpoint = v.viewpoint;
       bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
       bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
-      bt.crop = cropRendering(view, e.origin_x, e.origin_y, e.linemod.levels[0].width, e.linemod.levels[0].height);
+      bt.crop = cropRendering(view, e.origin_x, e.origin_y);
       ok[i] = 1;
     });
     for (std::size_t i = 0; i < todo.size(); ++i) {
