@@ -94,6 +94,10 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
                                      const std::vector<TrainingView>& views, const TrainingProgress& progress = {},
                                      TrainingTimings* timings = nullptr);
 
+/// The square tile training renders into: the params' focal length (made square), the
+/// object's centre at the tile's centre, big enough for the object from the nearest view.
+Camera trainingCamera(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views);
+
 /// The features of one rendering (tile pixels) as a template; `ok` false when a modality
 /// that is on has fewer than 4 features at some level.
 struct ExtractedTemplate {

@@ -15,6 +15,7 @@ namespace vkpose::cli {
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
   bench->require_subcommand(1);
+  addBenchTrainCommand(*bench, global);
   auto* match = bench->add_subcommand("match", "LINEMOD matching: vkpose vs OpenCV's cv::linemod, same templates");
   auto options = std::make_shared<bench::MatchBenchOptions>();
   auto json_path = std::make_shared<std::string>();
@@ -32,7 +33,8 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   match->add_option("--depth", options->depth, "Depth image, 16-bit PNG in mm");
   match->add_flag("!--no-opencv", options->run_opencv, "Skip the cv::linemod baseline");
   match->add_option("--json", *json_path, "Write the results as JSON to this file");
-  return [options, json_path, &global]() {
+  return [options, json_path, &global, match]() {
+    if (!match->parsed()) return 0;  // another bench subcommand ran in its callback
     if (options->rgb.empty() != options->depth.empty()) throw InputError("--rgb and --depth go together");
     if (!json_path->empty() && std::ifstream(*json_path).good())
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");

@@ -282,9 +282,9 @@ TemplateBank loadBank(const std::string& path) {
   uint64_t payload_bytes;
   std::memcpy(&payload_bytes, bytes.data() + 16, 8);
   const uint64_t expected = kHeaderBytes + payload_bytes + 8;
-  if (payload_bytes > bytes.size() || bytes.size() < expected)
-    throw InputError(fmt::format("{}: truncated template bank ({} of {} bytes)", path, bytes.size(),
-                                 payload_bytes > bytes.size() ? std::string("more than that") : std::to_string(expected)));
+  if (payload_bytes > (uint64_t{1} << 40) || bytes.size() < expected)
+    throw InputError(fmt::format("{}: truncated template bank ({} bytes; its header says {})", path, bytes.size(),
+                                 expected));
   if (bytes.size() > expected)
     throw InputError(fmt::format("{}: corrupt template bank ({} bytes after its end)", path, bytes.size() - expected));
   uint64_t stored;

@@ -226,9 +226,11 @@ TemplateCrop cropRendering(const Rendering& r, int template_x, int template_y) {
   return crop;
 }
 
-/// The square render tile that holds the object from every training view, with the
-/// object's centre at pixel (half, half), plus a margin for the feature filters.
-Camera trainingTile(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views) {
+}  // namespace
+
+// The tile holds the object from every training view, with the object's centre at pixel
+// (half, half), plus a margin for the feature filters.
+Camera trainingCamera(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views) {
   float bound = 0.f;
   const Eigen::Vector3f centre = mesh.bboxCentre();
   for (const auto& v : mesh.vertices) bound = std::max(bound, (v - centre).norm());
@@ -250,6 +252,8 @@ Camera trainingTile(const Mesh& mesh, const TrainingParams& params, const std::v
                                  tile.width, nearest));
   return tile;
 }
+
+namespace {
 
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -277,7 +281,7 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
   bank.symmetric = params.symmetric;
   bank.centre = mesh.bboxCentre();
   bank.params = params;
-  const Camera tile = trainingTile(mesh, params, views);
+  const Camera tile = trainingCamera(mesh, params, views);
   // Views differing only by in-plane rotation share one rendering: the GPU renders each
   // (viewpoint, distance) once and the rotations are image rotations of it (exact for a
   // pinhole camera with square pixels, up to nearest-neighbour resampling).
