@@ -39,32 +39,40 @@ struct Candidate {
 };
 
 /// LINEMOD's scattered selection: best first, each new feature at least `distance` from
-/// those already taken; the distance relaxes by one pixel after every pass.
+/// those already taken; the distance relaxes by one pixel after every pass. Each candidate's
+/// distance to the nearest taken feature is kept up to date, and passes that could take
+/// nothing are skipped, which gives the same choice as the plain loop in O(count * n).
 std::vector<Candidate> selectScattered(std::vector<Candidate> candidates, int count) {
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   if (static_cast<int>(candidates.size()) <= count) return candidates;
   std::vector<Candidate> chosen;
-  std::vector<bool> taken(candidates.size(), false);
+  constexpr float kFar = 1e30f;
+  std::vector<float> nearest_sq(candidates.size(), kFar);  // < 0: taken
   float distance = static_cast<float>(candidates.size() / static_cast<std::size_t>(count) + 1);
   while (static_cast<int>(chosen.size()) < count) {
     const float d2 = distance * distance;
+    float best_left = -1.f;
     for (std::size_t i = 0; i < candidates.size() && static_cast<int>(chosen.size()) < count; ++i) {
-      if (taken[i]) continue;
-      bool keep = true;
-      for (const auto& f : chosen) {
-        const float dx = static_cast<float>(candidates[i].x - f.x), dy = static_cast<float>(candidates[i].y - f.y);
-        if (dx * dx + dy * dy < d2) {
-          keep = false;
-          break;
-        }
+      if (nearest_sq[i] < 0.f) continue;
+      if (nearest_sq[i] < d2) {
+        best_left = std::max(best_left, nearest_sq[i]);
+        continue;
       }
-      if (keep) {
-        chosen.push_back(candidates[i]);
-        taken[i] = true;
+      chosen.push_back(candidates[i]);
+      nearest_sq[i] = -1.f;
+      for (std::size_t j = 0; j < candidates.size(); ++j) {
+        if (nearest_sq[j] < 0.f) continue;
+        const float dx = static_cast<float>(candidates[j].x - candidates[i].x),
+                    dy = static_cast<float>(candidates[j].y - candidates[i].y);
+        nearest_sq[j] = std::min(nearest_sq[j], dx * dx + dy * dy);
       }
     }
     distance -= 1.f;  // at distance 1 every untaken candidate qualifies, so this ends
+    // Skip the passes that would take nothing: the next one that takes something is the
+    // first whose distance^2 is at most the largest distance^2 left (these are integers).
+    if (best_left >= 0.f && best_left < distance * distance)
+      distance = std::max(1.f, std::floor(std::sqrt(best_left) + 1e-4f));
   }
   return chosen;
 }
