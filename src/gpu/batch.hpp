@@ -61,6 +61,7 @@ class Batch {
   vk::CommandBuffer cmd_;
   vk::Fence fence_;
   std::vector<vk::DescriptorPool> pools_;
+  std::vector<vk::BufferView> views_;  ///< texel-buffer views of the recorded dispatches
   uint32_t sets_in_pool_ = 0;
   std::vector<Buffer> staging_;
   std::size_t staging_used_ = 0;

@@ -21,9 +21,9 @@ struct RefinePush {
 
 struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
-      : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush)),
+      : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush), {}, {{0, vk::Format::eR32G32B32A32Uint}}),
         args(c, ShaderId::refine_args, 2, 4),
-        refine(c, ShaderId::similarity_refine, 5, sizeof(RefinePush)) {}
+        refine(c, ShaderId::similarity_refine, 5, sizeof(RefinePush), {}, {{0, vk::Format::eR32G32B32A32Uint}}) {}
   Kernel coarse, args, refine;
 };
 
