@@ -3,11 +3,10 @@
 // storage-buffer load at a per-invocation offset becomes a branchy scalar loop over the
 // lanes, once per 32-bit component. Each feature is a byte offset into the linear memories
 // (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes
-// (63 * 4 < 256), then widen into packed 16-bit lanes: `lo` holds positions 4j and 4j+2,
-// `hi` 4j+1 and 4j+3.
+// (63 * 4 < 256), then widen into packed 16-bit lanes (packed_scores.glsl).
 #extension GL_EXT_samplerless_texture_functions : require
 layout(binding = 0) uniform utextureBuffer memory;
-layout(std430, binding = 2) readonly buffer Features { int feature_offsets[]; };
+layout(binding = 2) uniform itextureBuffer feature_offsets;  // r32i
 
 // The 16 responses at byte offset `off`: two texels, their words picked and funnel-shifted
 // into alignment. The layouts' right and bottom margins keep the second texel inside the
@@ -36,15 +35,12 @@ void scoreSixteen(int first, int count, int base, out uvec4 lo, out uvec4 hi) {
   while (f < end) {
     int chunk_end = min(f + 63, end);
     uvec4 acc = uvec4(0u);
-    for (; f < chunk_end; ++f) acc += sixteenBytes(uint(feature_offsets[f] + base));
+    for (; f < chunk_end; ++f) acc += sixteenBytes(uint(texelFetch(feature_offsets, f).x + base));
     widen(acc, lo, hi);
   }
 }
 
-uint scoreAt(uvec4 lo, uvec4 hi, int p) {
-  uint v = (p & 1) == 0 ? lo[p >> 2] : hi[p >> 2];
-  return (v >> (16u * uint((p & 3) >> 1))) & 0xFFFFu;
-}
+#include "packed_scores.glsl"
 
 // Template header: first feature, feature count, first cell column, first cell row, raw
 // threshold, unused.

@@ -14,7 +14,8 @@ constexpr uint32_t kMaxBindings = 16;
 
 std::size_t texelBytes(vk::Format format) {
   switch (format) {
-    case vk::Format::eR32Uint: return 4;
+    case vk::Format::eR32Uint:
+    case vk::Format::eR32Sint: return 4;
     case vk::Format::eR32G32Uint: return 8;
     case vk::Format::eR32G32B32A32Uint: return 16;
     default: throw std::logic_error("gpu::Batch: unsupported texel-buffer format");
@@ -157,9 +158,9 @@ std::map<std::string, double>& kernelProfile() {
 }
 
 void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
-                             std::size_t push_bytes, const Buffer& args) {
+                             std::size_t push_bytes, const Buffer& args, std::size_t offset) {
   bind(kernel, buffers, push, push_bytes);
-  cmd_.dispatchIndirect(args.handle(), 0);
+  cmd_.dispatchIndirect(args.handle(), offset);
   afterDispatch(kernel);
 }
 
