@@ -10,6 +10,7 @@ namespace vkpose::gpu {
 namespace {
 constexpr int kHeaderInts = 6;
 constexpr uint32_t kGroup = 64;
+constexpr int kCoarseRows = 4;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
 constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
 constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
 // State buffer (refine_args.comp): unit count, most units of a chunk, next and this chunk's
@@ -151,7 +152,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features) {
                               static_cast<std::size_t>(grid.words_per_band);
     const CoarsePush push{chunk.first_template, cl.cells_x, cl.cells_y, cl.stride, blocks, capacity_};
     batch.dispatch(kernels_->coarse, {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_},
-                   push, groupsFor(static_cast<std::size_t>(cl.cells_y * blocks), kGroup),
+                   push, groupsFor(static_cast<std::size_t>((cl.cells_y + kCoarseRows - 1) / kCoarseRows * blocks), kGroup),
                    static_cast<uint32_t>(chunk.template_count));
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};
