@@ -1,11 +1,32 @@
-// Sum of one template's feature responses at 16 consecutive cell positions of one row.
-// Each feature is a byte offset into the linear memories (position (0, 0) of its grid
-// plane); 16 responses are 4 words read at that offset plus the row's base, shifted into
-// alignment. Up to 63 features add up in packed bytes (63 * 4 < 256), then widen into
-// packed 16-bit lanes: `lo` holds positions 4j and 4j+2, `hi` 4j+1 and 4j+3.
-layout(std430, binding = 0) readonly buffer Memory { uint memory[]; };
-layout(std430, binding = 2) readonly buffer Features { int feature_offsets[]; };
+// Shared by the similarity kernels. The linear memories are read as a texel buffer of
+// 16-byte texels: on llvmpipe (lavapipe) a texel fetch is one vector gather, while a
+// storage-buffer load at a per-invocation offset becomes a branchy scalar loop over the
+// lanes, once per 32-bit component. Each feature is a byte offset into the linear memories
+// (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes
+// (63 * 4 < 256), then widen into packed 16-bit lanes (packed_scores.glsl).
+#extension GL_EXT_samplerless_texture_functions : require
+layout(binding = 0) uniform utextureBuffer memory;
+layout(binding = 2) uniform itextureBuffer feature_offsets;  // r32i
 
+// The 16 responses at byte offset `off`: two texels, their words picked and funnel-shifted
+// into alignment. The layouts' right and bottom margins keep the second texel inside the
+// buffer.
+uvec4 sixteenBytes(uint off) {
+  uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
+  int t = int(off >> 4);
+  uvec4 x = texelFetch(memory, t), y = texelFetch(memory, t + 1);
+  uvec4 a = q == 0u ? x : q == 1u ? uvec4(x.yzw, y.x) : q == 2u ? uvec4(x.zw, y.xy) : uvec4(x.w, y.xyz);
+  uint e = q == 0u ? y.x : q == 1u ? y.y : q == 2u ? y.z : y.w;
+  return s == 0u ? a : (a >> s) | (uvec4(a.yzw, e) << (32u - s));
+}
+
+// Widens packed byte sums into the packed 16-bit totals.
+void widen(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
+  lo += acc & 0x00FF00FFu;
+  hi += (acc >> 8u) & 0x00FF00FFu;
+}
+
+// Sum of one template's feature responses at 16 consecutive cell positions of one row.
 void scoreSixteen(int first, int count, int base, out uvec4 lo, out uvec4 hi) {
   lo = uvec4(0u);
   hi = uvec4(0u);
@@ -14,23 +35,12 @@ void scoreSixteen(int first, int count, int base, out uvec4 lo, out uvec4 hi) {
   while (f < end) {
     int chunk_end = min(f + 63, end);
     uvec4 acc = uvec4(0u);
-    for (; f < chunk_end; ++f) {
-      uint off = uint(feature_offsets[f] + base);
-      uint w = off >> 2;
-      uint s = (off & 3u) * 8u;
-      uvec4 a = uvec4(memory[w], memory[w + 1u], memory[w + 2u], memory[w + 3u]);
-      if (s != 0u) a = (a >> s) | (uvec4(a.yzw, memory[w + 4u]) << (32u - s));
-      acc += a;
-    }
-    lo += acc & 0x00FF00FFu;
-    hi += (acc >> 8u) & 0x00FF00FFu;
+    for (; f < chunk_end; ++f) acc += sixteenBytes(uint(texelFetch(feature_offsets, f).x + base));
+    widen(acc, lo, hi);
   }
 }
 
-uint scoreAt(uvec4 lo, uvec4 hi, int p) {
-  uint v = (p & 1) == 0 ? lo[p >> 2] : hi[p >> 2];
-  return (v >> (16u * uint((p & 3) >> 1))) & 0xFFFFu;
-}
+#include "packed_scores.glsl"
 
 // Template header: first feature, feature count, first cell column, first cell row, raw
 // threshold, unused.

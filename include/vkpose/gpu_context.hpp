@@ -18,6 +18,7 @@ struct GpuDeviceInfo {
   std::string api_version;            ///< "1.3.230"
   std::string driver;                 ///< driver name and info, when the driver reports them
   uint64_t max_storage_buffer_range = 0;  ///< bytes one storage-buffer binding may span
+  uint64_t max_texel_buffer_elements = 0; ///< texels one texel-buffer binding may span
   uint32_t max_shared_memory = 0;         ///< bytes of shared memory per workgroup
   uint32_t subgroup_size = 0;             ///< lanes per subgroup
   uint32_t max_workgroup_invocations = 0;

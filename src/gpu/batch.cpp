@@ -11,6 +11,16 @@ namespace vkpose::gpu {
 namespace {
 constexpr uint32_t kSetsPerPool = 256;
 constexpr uint32_t kMaxBindings = 16;
+
+std::size_t texelBytes(vk::Format format) {
+  switch (format) {
+    case vk::Format::eR32Uint:
+    case vk::Format::eR32Sint: return 4;
+    case vk::Format::eR32G32Uint: return 8;
+    case vk::Format::eR32G32B32A32Uint: return 16;
+    default: throw std::logic_error("gpu::Batch: unsupported texel-buffer format");
+  }
+}
 }  // namespace
 
 Batch::Batch(const GpuContext& ctx) : ctx_(ctx), device_(ctx.state().device) {
@@ -26,6 +36,7 @@ Batch::~Batch() {
   device_.destroyFence(fence_);
   device_.freeCommandBuffers(ctx_.state().command_pool, cmd_);
   for (auto pool : pools_) device_.destroyDescriptorPool(pool);
+  for (auto view : views_) device_.destroyBufferView(view);
 }
 
 void Batch::begin() {
@@ -74,29 +85,47 @@ void Batch::bind(const Kernel& kernel, std::initializer_list<BufferView> buffers
     throw std::logic_error(std::string("kernel ") + kernel.name() + ": push-constant size mismatch");
   begin();
   if (pools_.empty() || sets_in_pool_ == kSetsPerPool) {
-    vk::DescriptorPoolSize size{.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = kSetsPerPool * kMaxBindings};
-    pools_.push_back(device_.createDescriptorPool({.maxSets = kSetsPerPool, .poolSizeCount = 1, .pPoolSizes = &size}));
+    const vk::DescriptorPoolSize sizes[2] = {
+        {.type = vk::DescriptorType::eStorageBuffer, .descriptorCount = kSetsPerPool * kMaxBindings},
+        {.type = vk::DescriptorType::eUniformTexelBuffer, .descriptorCount = kSetsPerPool * kMaxBindings}};
+    pools_.push_back(device_.createDescriptorPool({.maxSets = kSetsPerPool, .poolSizeCount = 2, .pPoolSizes = sizes}));
     sets_in_pool_ = 0;
   }
   auto layout = kernel.setLayout();
   vk::DescriptorSet set =
       device_.allocateDescriptorSets({.descriptorPool = pools_.back(), .descriptorSetCount = 1, .pSetLayouts = &layout})[0];
   ++sets_in_pool_;
-  std::vector<vk::DescriptorBufferInfo> infos;
-  infos.reserve(buffers.size());
-  for (const auto& v : buffers) {
-    const std::size_t range = v.range ? v.range : v.buffer->size() - v.offset;
-    if (range > ctx_.device().max_storage_buffer_range)
-      throw DeviceError(std::string("kernel ") + kernel.name() + ": a binding exceeds maxStorageBufferRange");
-    infos.push_back({.buffer = v.buffer->handle(), .offset = v.offset, .range = std::max<std::size_t>(range, 4)});
-  }
+  std::vector<vk::DescriptorBufferInfo> infos(buffers.size());
+  std::vector<vk::BufferView> views(buffers.size());
   std::vector<vk::WriteDescriptorSet> writes;
-  for (uint32_t i = 0; i < infos.size(); ++i)
-    writes.push_back({.dstSet = set,
-                      .dstBinding = i,
-                      .descriptorCount = 1,
-                      .descriptorType = vk::DescriptorType::eStorageBuffer,
-                      .pBufferInfo = &infos[i]});
+  uint32_t i = 0;
+  for (const auto& v : buffers) {
+    const std::size_t range = std::max<std::size_t>(v.range ? v.range : v.buffer->size() - v.offset, 4);
+    const vk::Format format = kernel.texelFormat(i);
+    if (format == vk::Format::eUndefined) {
+      if (range > ctx_.device().max_storage_buffer_range)
+        throw DeviceError(std::string("kernel ") + kernel.name() + ": a binding exceeds maxStorageBufferRange");
+      infos[i] = vk::DescriptorBufferInfo{.buffer = v.buffer->handle(), .offset = v.offset, .range = range};
+      writes.push_back({.dstSet = set,
+                        .dstBinding = i,
+                        .descriptorCount = 1,
+                        .descriptorType = vk::DescriptorType::eStorageBuffer,
+                        .pBufferInfo = &infos[i]});
+    } else {
+      const std::size_t texel = texelBytes(format);
+      if (range / texel > ctx_.device().max_texel_buffer_elements)
+        throw DeviceError(std::string("kernel ") + kernel.name() + ": a binding exceeds maxTexelBufferElements");
+      views[i] = device_.createBufferView(
+          {.buffer = v.buffer->handle(), .format = format, .offset = v.offset, .range = range / texel * texel});
+      views_.push_back(views[i]);
+      writes.push_back({.dstSet = set,
+                        .dstBinding = i,
+                        .descriptorCount = 1,
+                        .descriptorType = vk::DescriptorType::eUniformTexelBuffer,
+                        .pTexelBufferView = &views[i]});
+    }
+    ++i;
+  }
   device_.updateDescriptorSets(writes, {});
   cmd_.bindPipeline(vk::PipelineBindPoint::eCompute, kernel.pipeline());
   cmd_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, kernel.layout(), 0, set, {});
@@ -129,9 +158,9 @@ std::map<std::string, double>& kernelProfile() {
 }
 
 void Batch::dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
-                             std::size_t push_bytes, const Buffer& args) {
+                             std::size_t push_bytes, const Buffer& args, std::size_t offset) {
   bind(kernel, buffers, push, push_bytes);
-  cmd_.dispatchIndirect(args.handle(), 0);
+  cmd_.dispatchIndirect(args.handle(), offset);
   afterDispatch(kernel);
 }
 
@@ -167,6 +196,8 @@ void Batch::submit() {
     pools_.resize(1);
   }
   sets_in_pool_ = 0;
+  for (auto view : views_) device_.destroyBufferView(view);
+  views_.clear();
   cmd_.reset();
 }
 

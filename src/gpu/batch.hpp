@@ -2,6 +2,7 @@
 // Records everything a frame needs (uploads, dispatches, downloads) into one command buffer,
 // submitted once with one fence. A barrier follows each recorded operation, so each dispatch
 // sees the results of everything recorded before it.
+#include <algorithm>
 #include <cstddef>
 #include <initializer_list>
 #include <map>
@@ -32,13 +33,14 @@ class Batch {
                 uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
     dispatchRaw(kernel, buffers, &push, sizeof(Push), gx, gy, gz);
   }
-  /// Like dispatch(), with the workgroup counts read on the device from `args` (3 uints).
+  /// Like dispatch(), with the workgroup counts read on the device from `args` (3 uints at
+  /// byte `offset`).
   void dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,
-                           std::size_t push_bytes, const Buffer& args);
+                           std::size_t push_bytes, const Buffer& args, std::size_t offset = 0);
   template <class Push>
   void dispatchIndirect(const Kernel& kernel, std::initializer_list<BufferView> buffers, const Push& push,
-                        const Buffer& args) {
-    dispatchIndirectRaw(kernel, buffers, &push, sizeof(Push), args);
+                        const Buffer& args, std::size_t offset = 0) {
+    dispatchIndirectRaw(kernel, buffers, &push, sizeof(Push), args, offset);
   }
   /// After submit(), `bytes` of `src` at `offset` land in `dst` (host memory that must outlive
   /// the submit).
@@ -61,6 +63,7 @@ class Batch {
   vk::CommandBuffer cmd_;
   vk::Fence fence_;
   std::vector<vk::DescriptorPool> pools_;
+  std::vector<vk::BufferView> views_;  ///< texel-buffer views of the recorded dispatches
   uint32_t sets_in_pool_ = 0;
   std::vector<Buffer> staging_;
   std::size_t staging_used_ = 0;
@@ -81,6 +84,15 @@ std::map<std::string, double>& kernelProfile();
 /// Workgroup count that covers `n` items with groups of `size`.
 inline uint32_t groupsFor(std::size_t n, uint32_t size) {
   return static_cast<uint32_t>((n + size - 1) / size);
+}
+
+/// The same as a 2D grid of at most 32768 columns (item = (y * 32768 + x) * size + local).
+struct Groups2D {
+  uint32_t x = 1, y = 1;
+};
+inline Groups2D groups2DFor(std::size_t n, uint32_t size) {
+  const uint32_t g = groupsFor(n, size);
+  return {std::max<uint32_t>(std::min<uint32_t>(g, 32768u), 1u), (g + 32767u) / 32768u};
 }
 
 }  // namespace vkpose::gpu

@@ -44,7 +44,8 @@ void Buffer::reserve(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) 
   device_ = s.device;
   buffer_ = s.device.createBuffer(
       {.size = alloc,
-       .usage = vk::BufferUsageFlagBits::eStorageBuffer | vk::BufferUsageFlagBits::eTransferSrc |
+       .usage = vk::BufferUsageFlagBits::eStorageBuffer | vk::BufferUsageFlagBits::eUniformTexelBuffer |
+                vk::BufferUsageFlagBits::eTransferSrc |
                 vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eIndirectBuffer});
   auto req = s.device.getBufferMemoryRequirements(buffer_);
   const auto flags = host ? vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent

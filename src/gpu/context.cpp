@@ -83,6 +83,7 @@ GpuDeviceInfo describe(vk::PhysicalDevice pd, uint32_t index) {
   info.api_version = versionString(props.apiVersion);
   info.driver = std::string(driver.driverName.data()) + " " + driver.driverInfo.data();
   info.max_storage_buffer_range = props.limits.maxStorageBufferRange;
+  info.max_texel_buffer_elements = props.limits.maxTexelBufferElements;
   info.max_shared_memory = props.limits.maxComputeSharedMemorySize;
   info.subgroup_size = chain.get<vk::PhysicalDeviceSubgroupProperties>().subgroupSize;
   info.max_workgroup_invocations = props.limits.maxComputeWorkGroupInvocations;

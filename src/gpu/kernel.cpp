@@ -5,13 +5,20 @@
 namespace vkpose::gpu {
 
 Kernel::Kernel(const GpuContext& ctx, ShaderId shader, uint32_t buffer_count, uint32_t push_constant_bytes,
-               const std::vector<uint32_t>& specialization)
-    : device_(ctx.state().device), shader_(shader), buffer_count_(buffer_count), push_bytes_(push_constant_bytes) {
+               const std::vector<uint32_t>& specialization, const std::vector<TexelBinding>& texel_bindings)
+    : device_(ctx.state().device),
+      shader_(shader),
+      buffer_count_(buffer_count),
+      push_bytes_(push_constant_bytes),
+      texel_formats_(buffer_count, vk::Format::eUndefined) {
   const auto& code = embeddedShader(shader);
+  for (const auto& t : texel_bindings) texel_formats_.at(t.binding) = t.format;
   std::vector<vk::DescriptorSetLayoutBinding> bindings;
   for (uint32_t b = 0; b < buffer_count; ++b)
     bindings.push_back({.binding = b,
-                        .descriptorType = vk::DescriptorType::eStorageBuffer,
+                        .descriptorType = texel_formats_[b] == vk::Format::eUndefined
+                                              ? vk::DescriptorType::eStorageBuffer
+                                              : vk::DescriptorType::eUniformTexelBuffer,
                         .descriptorCount = 1,
                         .stageFlags = vk::ShaderStageFlagBits::eCompute});
   set_layout_ = device_.createDescriptorSetLayout(

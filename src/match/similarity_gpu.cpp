@@ -9,22 +9,56 @@ namespace vkpose::gpu {
 
 namespace {
 constexpr int kHeaderInts = 6;
+constexpr uint32_t kGroup = 64;
+constexpr int kCoarseRows = 4;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
+constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
+constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
+// State buffer (refine_args.comp): unit count, most units of a chunk, next and this chunk's
+// first candidate, then the indirect dispatch sizes over the chunk's candidates and units.
+constexpr std::size_t kStateBytes = 48, kCandidateArgs = 16, kUnitArgs = 32;
+
+struct UnitGrid {
+  int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0;
+};
 struct CoarsePush {
   int32_t template_base, columns, rows, stride, blocks;
   uint32_t capacity;
 };
-struct RefinePush {
-  int32_t template_base, template_count, T_coarse, T_fine, stride;
-  uint32_t capacity;
+struct UnitsPush {
+  uint32_t words, capacity;
 };
+struct ArgsPush {
+  uint32_t stage, unit_capacity, candidate_capacity;
+};
+struct RefinePush {
+  int32_t stride;
+  uint32_t capacity;
+  UnitGrid grid;
+};
+struct ChunkPush {  // refine_mark, refine_select
+  int32_t template_base;
+  UnitGrid grid;
+};
+
+UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fine) {
+  return {coarse.T, fine.T, fine.pad, (fine.rows + kUnitBand - 1) / kUnitBand,
+          (fine.stride / match::kRefineWindow + 31) / 32};
+}
 }  // namespace
 
 struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
-      : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush)),
-        args(c, ShaderId::refine_args, 2, 4),
-        refine(c, ShaderId::similarity_refine, 5, sizeof(RefinePush)) {}
-  Kernel coarse, args, refine;
+      : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush), {}, kMemoryAndOffsets),
+        mark(c, ShaderId::refine_mark, 3, sizeof(ChunkPush)),
+        units(c, ShaderId::refine_units, 4, sizeof(UnitsPush)),
+        args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
+        refine(c, ShaderId::similarity_refine, 6, sizeof(RefinePush), {}, kMemoryAndOffsets),
+        select(c, ShaderId::refine_select, 6, sizeof(ChunkPush), {},
+               {{0, vk::Format::eR32Uint}, {1, vk::Format::eR32Uint}, {2, vk::Format::eR32G32B32A32Uint}}) {}
+  // Linear memory and feature offsets are read as texel buffers (similarity_common.glsl).
+  static inline const std::vector<TexelBinding> kMemoryAndOffsets{{0, vk::Format::eR32G32B32A32Uint},
+                                                                  {2, vk::Format::eR32Sint}};
+  Kernel coarse, mark, units, args, refine, select;
 };
 
 Similarity::Similarity(const GpuContext& ctx) : ctx_(ctx), kernels_(std::make_unique<Kernels>(ctx)) {}
@@ -36,14 +70,29 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   layouts_ = layouts;
   chunks_.clear();
   const std::size_t levels = layouts.size();
-  // Chunks: at most 65535 templates (workgroup rows) and features that fit one binding.
-  const std::size_t max_bytes = std::min<std::size_t>(ctx_.device().max_storage_buffer_range, 64u << 20);
+  // Chunks: at most 65535 templates (workgroup rows), features that fit one binding, and
+  // with refinement as many templates as the unit scores of one binding can hold even if
+  // every unit of every template is covered.
+  const auto& dev = ctx_.device();
+  const std::size_t max_bytes = std::min<std::size_t>(dev.max_storage_buffer_range, 64u << 20);
+  std::size_t max_templates = 65535;
+  std::size_t units_per_template = 0;
+  if (levels > 1) {
+    const auto& fl = layouts[0];
+    units_per_template = static_cast<std::size_t>((fl.rows + kUnitBand - 1) / kUnitBand) *
+                         static_cast<std::size_t>(fl.stride / match::kRefineWindow);
+    const std::size_t max_units =
+        std::min<std::size_t>({dev.max_storage_buffer_range, dev.max_texel_buffer_elements * 16, 1u << 30}) /
+        kUnitScoreBytes;
+    max_templates = std::clamp<std::size_t>(max_units / units_per_template, 1, max_templates);
+  }
   std::size_t t = 0;
+  std::size_t largest = 0;
   while (t < templates.size()) {
     Chunk chunk;
     chunk.first_template = static_cast<int>(t);
     std::vector<int32_t> headers[2], offsets[2];
-    while (t < templates.size() && chunk.template_count < 65535) {
+    while (t < templates.size() && static_cast<std::size_t>(chunk.template_count) < max_templates) {
       std::size_t add = 0;
       for (const auto& level : templates[t].levels) add += level.features.size() * 4;
       if (chunk.template_count > 0 && (offsets[0].size() + offsets[1].size()) * 4 + add > max_bytes) break;
@@ -62,6 +111,7 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
       ++chunk.template_count;
       ++t;
     }
+    largest = std::max<std::size_t>(largest, static_cast<std::size_t>(chunk.template_count));
     for (std::size_t l = 0; l < levels; ++l) {
       chunk.headers[l] = Buffer(ctx_, headers[l].size() * 4);
       chunk.offsets[l] = Buffer(ctx_, offsets[l].size() * 4);
@@ -70,29 +120,55 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
     }
     chunks_.push_back(std::move(chunk));
   }
+  if (levels > 1) {
+    const UnitGrid grid = unitGrid(layouts[levels - 1], layouts[0]);
+    mark_words_ = largest * static_cast<std::size_t>(grid.bands) * static_cast<std::size_t>(grid.words_per_band);
+    max_unit_capacity_ = static_cast<uint32_t>(largest * units_per_template);
+    unit_capacity_ = std::min(unit_capacity_, max_unit_capacity_);
+  }
 }
 
 void Similarity::record(Batch& batch, const FrameFeatures& features) {
   const std::size_t coarse = layouts_.size() - 1;
   const auto& cl = layouts_[coarse];
+  const bool refine = coarse > 0;
   candidates_.reserve(ctx_, 16 + static_cast<std::size_t>(capacity_) * 16, MemoryKind::HostVisible);
   results_.reserve(ctx_, static_cast<std::size_t>(capacity_) * 8, MemoryKind::HostVisible);
-  args_.reserve(ctx_, 16);
+  state_.reserve(ctx_, kStateBytes, MemoryKind::HostVisible);
   batch.fill(candidates_, 0u, 16);
-  const int blocks = (cl.cells_x + match::kRefineWindow - 1) / match::kRefineWindow;
-  for (const auto& chunk : chunks_) {
-    const CoarsePush push{chunk.first_template, cl.cells_x, cl.cells_y, cl.stride, blocks, capacity_};
-    batch.dispatch(kernels_->coarse, {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_},
-                   push, groupsFor(static_cast<std::size_t>(cl.cells_y * blocks), 64),
-                   static_cast<uint32_t>(chunk.template_count));
+  batch.fill(state_, 0u, kStateBytes);
+  UnitGrid grid;
+  if (refine) {
+    grid = unitGrid(cl, layouts_[0]);
+    marks_.reserve(ctx_, mark_words_ * 4);
+    bases_.reserve(ctx_, mark_words_ * 4);
+    units_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * 4);
+    scores_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * kUnitScoreBytes);
   }
-  if (coarse == 0) return;
-  batch.dispatch(kernels_->args, {candidates_, args_}, capacity_, 1);
+  const int blocks = (cl.cells_x + match::kRefineWindow - 1) / match::kRefineWindow;
   const auto& fl = layouts_[0];
   for (const auto& chunk : chunks_) {
-    const RefinePush push{chunk.first_template, chunk.template_count, cl.T, fl.T, fl.stride, capacity_};
+    const std::size_t words = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands) *
+                              static_cast<std::size_t>(grid.words_per_band);
+    const CoarsePush push{chunk.first_template, cl.cells_x, cl.cells_y, cl.stride, blocks, capacity_};
+    batch.dispatch(kernels_->coarse, {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_},
+                   push, groupsFor(static_cast<std::size_t>((cl.cells_y + kCoarseRows - 1) / kCoarseRows * blocks), kGroup),
+                   static_cast<uint32_t>(chunk.template_count));
+    if (!refine) continue;
+    const ChunkPush chunk_push{chunk.first_template, grid};
+    batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);
+    batch.fill(marks_, 0u, words * 4);
+    batch.dispatchIndirect(kernels_->mark, {candidates_, state_, marks_}, chunk_push, state_, kCandidateArgs);
+    batch.fill(state_, 0u, 4);  // this chunk's unit count
+    const auto g = groups2DFor(words, kGroup);
+    batch.dispatch(kernels_->units, {marks_, bases_, units_, state_},
+                   UnitsPush{static_cast<uint32_t>(words), unit_capacity_}, g.x, g.y);
+    batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{1, unit_capacity_, capacity_}, 1);
     batch.dispatchIndirect(kernels_->refine,
-                           {features.memory(0), chunk.headers[0], chunk.offsets[0], candidates_, results_}, push, args_);
+                           {features.memory(0), chunk.headers[0], chunk.offsets[0], units_, state_, scores_},
+                           RefinePush{fl.stride, unit_capacity_, grid}, state_, kUnitArgs);
+    batch.dispatchIndirect(kernels_->select, {marks_, bases_, scores_, candidates_, state_, results_}, chunk_push,
+                           state_, kCandidateArgs);
   }
 }
 
@@ -101,10 +177,19 @@ bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vect
   const uint32_t count = words[0];
   candidates.clear();
   refined.clear();
+  bool complete = true;
   if (count > capacity_) {
     capacity_ = std::max(count + count / 4, capacity_ * 2);
-    return false;
+    complete = false;
   }
+  if (layouts_.size() > 1) {
+    const uint32_t max_units = static_cast<const uint32_t*>(state_.mapped())[1];
+    if (max_units > unit_capacity_) {
+      unit_capacity_ = std::min(std::max(max_units + max_units / 4, unit_capacity_ * 2), max_unit_capacity_);
+      complete = false;
+    }
+  }
+  if (!complete) return false;
   candidates.resize(count);
   for (uint32_t i = 0; i < count; ++i) {
     const uint32_t* item = words + 4 + 4 * i;

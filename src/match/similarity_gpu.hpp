@@ -1,6 +1,9 @@
 #pragma once
 // Stage 2 on the GPU: template headers and feature offsets on the device, coarse scoring of
 // every template, indirect refinement of the candidates, all recorded into the frame's batch.
+// Refinement scores each unit (one template, 4 finer-level rows, one 16-cell block) that
+// some candidate's window covers once (shaders/refine_grid.glsl), then picks each
+// candidate's best position from the units.
 #include <memory>
 #include <vector>
 
@@ -24,7 +27,7 @@ class Similarity {
   void record(Batch& batch, const FrameFeatures& features);
 
   /// After the batch's submit: the candidates and refinements. Returns false when the
-  /// candidate list overflowed (it grows; run the frame again).
+  /// candidate list or the unit list overflowed (they grow; run the frame again).
   bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
 
  private:
@@ -38,8 +41,12 @@ class Similarity {
   std::vector<Chunk> chunks_;
   std::vector<LinearMemoryLayout> layouts_;
   FeatureParams feature_params_;
-  uint32_t capacity_ = 1u << 16;
-  Buffer candidates_, results_, args_;
+  uint32_t capacity_ = 1u << 16;       // candidate slots
+  uint32_t unit_capacity_ = 1u << 16;  // unit slots of one chunk
+  uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk
+  std::size_t mark_words_ = 0;         // mark words of the largest chunk
+  Buffer candidates_, results_;
+  Buffer marks_, bases_, units_, scores_, state_;
 };
 
 }  // namespace vkpose::gpu

@@ -1,0 +1,31 @@
+// Refinement works on units: one template's responses at BAND consecutive finer-level rows
+// (padded rows BAND k .. BAND k + BAND - 1) and one 16-cell block of those rows (cells
+// -pad + 16 b .. -pad + 16 b + 15). Candidates of a template near each other have heavily
+// overlapping 16 x 16 windows; each unit they cover is scored once, and each feature's
+// offset is read once for the BAND rows. A chunk's units are bits of a mark array: per
+// template, per band, `words_per_band` words of one bit per block.
+const int BAND = 4;  // match kUnitBand in similarity_gpu.cpp
+struct UnitGrid {
+  int T_coarse, T_fine;
+  int pad;             // finer layout's padding cells
+  int bands;           // bands of the finer layout's padded rows
+  int words_per_band;  // mark words per band
+};
+
+int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// Finer-level cell (row, column) of the refinement window of coarse cell (r, c), as in
+// match::refineWindowStart.
+ivec2 windowStart(UnitGrid g, int r, int c) {
+  int offset = g.T_coarse / 2 + (g.T_coarse % 2 - 1);
+  return ivec2(floorDiv(2 * (r * g.T_coarse + offset) + 1, g.T_fine),
+               floorDiv(2 * (c * g.T_coarse + offset) + 1, g.T_fine)) - 8;
+}
+
+// Bit of the unit of band `band` holding finer-level column `column` of the chunk's
+// template t.
+uint bandBit(UnitGrid g, int t, int band, int column) {
+  return uint((t * g.bands + band) * g.words_per_band * 32 + ((column + g.pad) >> 4));
+}
+
+int bandOf(UnitGrid g, int row) { return (row + g.pad) / BAND; }
