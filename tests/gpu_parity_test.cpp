@@ -64,9 +64,12 @@ TEST(GpuParity, FrameFeaturesOnOddSizes) {
   }
 }
 
-void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, int template_count, float threshold) {
-  const auto templates = test::templatesFrom(frame, params, template_count);
+void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, int template_count, float threshold,
+                       int copies = 1) {
+  auto templates = test::templatesFrom(frame, params, template_count);
   ASSERT_GT(templates.size(), 10u);
+  const auto originals = templates;
+  for (int c = 1; c < copies; ++c) templates.insert(templates.end(), originals.begin(), originals.end());
   MatchParams mp;
   mp.threshold = threshold;
   const auto reference = matchTemplatesReference(quantizeFramePyramid(frame, params), templates, params, mp);
@@ -84,6 +87,13 @@ TEST(GpuParity, MatchesOnRealFramesBothModalities) {
   VKPOSE_REQUIRE_SHARED_DATA();
   expectMatchParity(test::lmoFrame(), {}, 60, 80.0f);
   expectMatchParity(test::icbinFrame(), {}, 60, 80.0f);
+}
+
+TEST(GpuParity, MatchesAcrossSeveralTemplateChunks) {
+  // Over 1,849 templates the GPU matcher splits them into chunks (the unit scores of a
+  // chunk must fit one binding): 60 copies of 40 templates cross that boundary.
+  VKPOSE_REQUIRE_SHARED_DATA();
+  expectMatchParity(test::lmoFrame(), {}, 40, 92.0f, 60);
 }
 
 TEST(GpuParity, MatchesWithOneModalityAndOneLevel) {
