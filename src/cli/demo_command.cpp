@@ -13,7 +13,8 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
   return [&global]() {
     GpuContext ctx(global.gpu());
     fmt::print("vkpose demo: Vulkan device: {} ({})\n", ctx.device().name, ctx.device().type);
-    fmt::print("Stages available so far: frame features and LINEMOD matching on the GPU (stages 1-2).\n");
+    fmt::print("Stages available so far: training (vkpose train MESH --out BANK), frame features and LINEMOD "
+               "matching on the GPU (stages 0-2).\n");
     bench::MatchBenchOptions o;
     o.template_counts = {500};
     o.repeats = 3;
@@ -24,7 +25,7 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
     fmt::print("Matched {} templates on {}:\n", r.templates, frame);
     fmt::print("  vkpose  {:8.2f} ms  {} matches\n", r.vkpose_ms, r.vkpose_matches);
     fmt::print("  OpenCV  {:8.2f} ms  {} matches  (cv::linemod, same templates)\n", r.opencv_ms, r.opencv_matches);
-    fmt::print("Training, detection hypotheses, 6-DoF poses and the bin-picking demo follow (issues 3-7).\n");
+    fmt::print("Detection hypotheses, 6-DoF poses and the bin-picking demo follow (issues 4-7).\n");
     return 0;
   };
 }
