@@ -76,7 +76,9 @@ float exactDiameter(const std::vector<Eigen::Vector3f>& points) {
   return best;
 }
 
-void finishMesh(Mesh& mesh) {
+namespace {
+/// What every mesh must satisfy before it can be measured.
+void checkMeshData(const Mesh& mesh) {
   if (mesh.faces.empty() || mesh.vertices.empty()) throw InputError(fmt::format("mesh '{}' has no triangles", mesh.name));
   const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& v : mesh.vertices)
@@ -88,6 +90,12 @@ void finishMesh(Mesh& mesh) {
     throw InputError(fmt::format("mesh '{}': {} normals for {} vertices", mesh.name, mesh.normals.size(), n));
   if (!mesh.colours.empty() && mesh.colours.size() != mesh.vertices.size())
     throw InputError(fmt::format("mesh '{}': {} colours for {} vertices", mesh.name, mesh.colours.size(), n));
+}
+}  // namespace
+
+void finishMesh(Mesh& mesh) {
+  checkMeshData(mesh);
+  const int n = static_cast<int>(mesh.vertices.size());
   mesh.bbox_min = mesh.bbox_max = mesh.vertices[0];
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const auto& v : mesh.vertices) {
@@ -165,19 +173,22 @@ Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) 
                               base + static_cast<int>(face.mIndices[2]));
     }
   }
-  if (mesh.faces.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", path));
-  for (const auto& v : mesh.vertices)
-    if (!v.allFinite()) throw InputError(fmt::format("{}: the mesh has a NaN or infinite vertex", path));
-
-  const float file_diameter = exactDiameter(mesh.vertices);
-  MeshUnits used = units;
-  if (units == MeshUnits::Auto) used = file_diameter > 10.f ? MeshUnits::Millimetres : MeshUnits::Metres;
-  if (used == MeshUnits::Millimetres)
-    for (auto& v : mesh.vertices) v *= 0.001f;
+  // Checked and measured in the file's own units, which decide the unit when it is Auto;
+  // millimetres are then scaled, measurements included.
   try {
     finishMesh(mesh);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", path, e.what()));
+  }
+  const float file_diameter = mesh.diameter;
+  MeshUnits used = units;
+  if (units == MeshUnits::Auto) used = file_diameter > 10.f ? MeshUnits::Millimetres : MeshUnits::Metres;
+  if (used == MeshUnits::Millimetres) {
+    for (auto& v : mesh.vertices) v *= 0.001f;
+    mesh.bbox_min *= 0.001f;
+    mesh.bbox_max *= 0.001f;
+    mesh.centroid *= 0.001f;
+    mesh.diameter *= 0.001f;
   }
   if (mesh.diameter < 1e-3f || mesh.diameter > 10.f)
     throw InputError(fmt::format("{}: the object is {:.4g} m across in {}; vkpose handles 1 mm to 10 m (check --units)",
