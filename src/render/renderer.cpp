@@ -120,13 +120,8 @@ Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy)
   cv::warpAffine(r.bgr, out.bgr, forward, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::Mat normals;
   cv::warpAffine(r.normals, normals, forward, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
-  out.normals.create(size, CV_32FC3);
-  for (int y = 0; y < size.height; ++y)
-    for (int x = 0; x < size.width; ++x) {
-      const cv::Vec3f n = normals.at<cv::Vec3f>(y, x);
-      out.normals.at<cv::Vec3f>(y, x) = {static_cast<float>(c * n[0] - s * n[1]), static_cast<float>(s * n[0] + c * n[1]),
-                                         n[2]};
-    }
+  const float cf = static_cast<float>(c), sf = static_cast<float>(s);
+  cv::transform(normals, out.normals, cv::Matx33f(cf, -sf, 0.f, sf, cf, 0.f, 0.f, 0.f, 1.f));
   return out;
 }
 
@@ -145,6 +140,7 @@ constexpr std::size_t kMaxViewsPerBatch = 256;
 struct MeshRenderer::Impl {
   Impl(const GpuContext& c, const Mesh& mesh)
       : ctx(c),
+        batch(c),
         raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush)),
         resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush)) {
     face_count = static_cast<uint32_t>(mesh.faces.size());
@@ -163,7 +159,6 @@ struct MeshRenderer::Impl {
     const std::size_t max_range = ctx.device().max_storage_buffer_range;
     if (v4.size() * 4 > max_range || f4.size() * 4 > max_range)
       throw InputError(fmt::format("mesh '{}' is too large for one device buffer ({} triangles)", mesh.name, face_count));
-    gpu::Batch batch(ctx);
     vertices = gpu::Buffer(ctx, v4.size() * 4);
     faces = gpu::Buffer(ctx, f4.size() * 4);
     normals = gpu::Buffer(ctx, n4.size() * 4);
@@ -175,6 +170,7 @@ struct MeshRenderer::Impl {
     batch.submit();
   }
   const GpuContext& ctx;
+  gpu::Batch batch;  ///< reused by every render(): one command buffer and fence
   gpu::Kernel raster, resolve;
   gpu::Buffer vertices, faces, normals, colours, poses, keys, depth, normal_out, colour_out;
   uint32_t face_count = 0, flags = 0;
@@ -225,7 +221,7 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     depth.resize(n * pixels);
     normals.resize(n * pixels * 4);
     colour.resize(n * pixels);
-    gpu::Batch batch(m.ctx);
+    gpu::Batch& batch = m.batch;
     batch.upload(m.poses, rows.data(), rows.size() * 4);
     batch.fill(m.keys, 0xFFFFFFFFu, n * pixels * 8);
     batch.dispatch(m.raster, {m.vertices, m.faces, m.poses, m.keys}, push, gpu::groupsFor(m.face_count, 64),
