@@ -104,6 +104,7 @@ struct ExtractedTemplate {
   bool ok = false;
   LinemodTemplate linemod;
   int origin_x = 0, origin_y = 0;  ///< template top-left in the rendering, level-0 pixels
+  cv::Rect object;                 ///< the object's bounding box in the rendering
 };
 ExtractedTemplate extractTemplate(const Rendering& rendering, const TrainingParams& params);
 

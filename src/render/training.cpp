@@ -131,9 +131,6 @@ std::vector<Candidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mas
   return out;
 }
 
-/// Nearest-neighbour halving, the same pixels as downsampleLabels keeps.
-cv::Mat halveMask(const cv::Mat& mask) { return downsampleLabels(mask); }
-
 }  // namespace
 
 ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& params) {
@@ -158,7 +155,7 @@ ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& p
   for (auto& c : chosen) c.resize(levels);
   for (std::size_t l = 0; l < levels; ++l) {
     if (l > 0) {
-      mask = halveMask(mask);
+      mask = downsampleLabels(mask);  // the pixels the depth labels keep
       if (fp.use_colour) bgr = pyrDownColour(bgr);
     }
     if (fp.use_colour) {
@@ -200,6 +197,7 @@ ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& p
       for (const auto& c : chosen[m][l])
         level.features.push_back({c.x - (min_x >> l), c.y - (min_y >> l), c.bin, static_cast<Modality>(m)});
   }
+  out.object = object;
   out.origin_x = min_x + x0;
   out.origin_y = min_y + y0;
   out.ok = true;
@@ -208,9 +206,8 @@ ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& p
 
 namespace {
 
-/// The crop of the object's box, positioned relative to the template's origin.
-TemplateCrop cropRendering(const Rendering& r, int template_x, int template_y) {
-  const cv::Rect box = cv::boundingRect(r.mask());
+/// The crop of the object's box `box`, positioned relative to the template's origin.
+TemplateCrop cropRendering(const Rendering& r, const cv::Rect& box, int template_x, int template_y) {
   const int origin_x = box.x, origin_y = box.y, width = box.width - 1, height = box.height - 1;
   TemplateCrop crop;
   crop.x0 = origin_x - template_x;
@@ -280,7 +277,6 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
                                      TrainingTimings* timings) {
   const auto t_start = std::chrono::steady_clock::now();
   validateTrainingParams(params);
-  if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles", mesh.name));
   if (views.empty()) throw InputError("no training views");
   TemplateBank bank;
   bank.object = mesh.name;
@@ -293,7 +289,6 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
   // Views differing only by in-plane rotation share one rendering: the GPU renders each
   // (viewpoint, distance) once and the rotations are image rotations of it (exact for a
   // pinhole camera with square pixels, up to nearest-neighbour resampling).
-  std::vector<std::size_t> base_of(views.size());
   std::vector<Pose> bases;
   std::vector<std::vector<std::size_t>> members;
   for (std::size_t i = 0; i < views.size(); ++i) {
@@ -322,8 +317,7 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
         todo.push_back(v);
         render_of.push_back(b - first);
       }
-    std::vector<BankTemplate> made(todo.size());
-    std::vector<char> ok(todo.size(), 0);
+    std::vector<BankTemplate> made(todo.size());  // no levels: the view gave no template
     util::parallelFor(todo.size(), [&](std::size_t i) {
       const TrainingView& v = views[todo[i]];
       const Rendering view = rotateInPlane(renders[render_of[i]], v.inplane_deg, tile.cx, tile.cy);
@@ -337,11 +331,10 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
       bt.viewpoint = v.viewpoint;
       bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
       bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
-      bt.crop = cropRendering(view, e.origin_x, e.origin_y);
-      ok[i] = 1;
+      bt.crop = cropRendering(view, e.object, e.origin_x, e.origin_y);
     });
     for (std::size_t i = 0; i < todo.size(); ++i) {
-      if (ok[i])
+      if (!made[i].linemod.levels.empty())
         bank.templates.push_back(std::move(made[i]));
       else
         ++t.dropped;
