@@ -239,7 +239,7 @@ TEST(Training, LmoTemplatesFindTheirObjectsInTheRealFrame) {
   params.views.viewpoints = 800;
   params.views.inplane_deg = {-180.f, 170.f, 10.f};
   std::vector<TemplateBank> banks;
-  std::vector<int> owner;
+  std::vector<std::pair<std::size_t, std::size_t>> owner;  // (bank, template in it) per matcher id
   std::vector<LinemodTemplate> all;
   for (const auto& g : truth) {
     const Mesh mesh =
@@ -253,9 +253,9 @@ TEST(Training, LmoTemplatesFindTheirObjectsInTheRealFrame) {
     }
     ASSERT_FALSE(views.empty());
     banks.push_back(trainTemplatesFromViews(test::context(), mesh, params, views));
-    for (const auto& t : banks.back().templates) {
-      all.push_back(t.linemod);
-      owner.push_back(static_cast<int>(banks.size()) - 1);
+    for (std::size_t i = 0; i < banks.back().templates.size(); ++i) {
+      all.push_back(banks.back().templates[i].linemod);
+      owner.emplace_back(banks.size() - 1, i);
     }
   }
   MatchParams mp;
@@ -273,14 +273,10 @@ TEST(Training, LmoTemplatesFindTheirObjectsInTheRealFrame) {
     std::vector<float> scores;
     float best_near = -1;
     for (const auto& m : matches) {
-      if (owner[m.template_id] != static_cast<int>(b)) continue;
+      const auto [bank, index] = owner[m.template_id];
+      if (bank != b) continue;
       scores.push_back(m.similarity);
-    }
-    std::size_t first = 0;
-    while (owner[first] != static_cast<int>(b)) ++first;
-    for (const auto& m : matches) {
-      if (owner[m.template_id] != static_cast<int>(b)) continue;
-      const auto& t = banks[b].templates[m.template_id - first];
+      const auto& t = banks[b].templates[index];
       const float dx = m.x + t.anchor_x - centre.x(), dy = m.y + t.anchor_y - centre.y();
       if (dx * dx + dy * dy <= 64.f) best_near = std::max(best_near, m.similarity);
     }
