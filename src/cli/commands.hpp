@@ -28,6 +28,7 @@ Runner addInfoCommand(CLI::App& app, const GlobalOptions& global);
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDemoCommand(CLI::App& app, const GlobalOptions& global);
 Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
+Runner addDetectCommand(CLI::App& app, const GlobalOptions& global);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   };
   add(addInfoCommand);
   add(addTrainCommand);
+  add(addDetectCommand);
   add(addBenchCommand);
   add(addDemoCommand);
 

@@ -1,0 +1,129 @@
+// Stages 3 and 5: template clustering and non-maximum suppression.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include <Eigen/Geometry>
+
+#include "vkpose/error.hpp"
+#include "vkpose/hypotheses.hpp"
+
+namespace vkpose {
+
+TemplateIndex::TemplateIndex(const std::vector<TemplateBank>& banks) {
+  first.reserve(banks.size() + 1);
+  int n = 0;
+  for (const auto& b : banks) {
+    first.push_back(n);
+    n += static_cast<int>(b.templates.size());
+  }
+  first.push_back(n);
+}
+
+int TemplateIndex::bankOf(int global_id) const {
+  if (global_id < 0 || global_id >= first.back())
+    throw InputError("template id " + std::to_string(global_id) + " is outside the banks' " +
+                     std::to_string(first.back()) + " templates");
+  const auto it = std::upper_bound(first.begin(), first.end() - 1, global_id);
+  return static_cast<int>(it - first.begin()) - 1;
+}
+
+std::vector<LinemodTemplate> concatenateTemplates(const std::vector<TemplateBank>& banks) {
+  std::vector<LinemodTemplate> all;
+  for (const auto& b : banks)
+    for (const auto& t : b.templates) all.push_back(t.linemod);
+  return all;
+}
+
+std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, const std::vector<TemplateBank>& banks,
+                                         const ClusterParams& params) {
+  if (params.position_step_px < 1) throw InputError("cluster position step s_im must be at least 1 pixel");
+  if (params.min_templates < 1) throw InputError("cluster size tau_c must be at least 1 template");
+  const TemplateIndex index(banks);
+  const float step = static_cast<float>(params.position_step_px);
+
+  // Key: bank, cell row, cell column, training distance (whole 0.1 mm, so equal radii group
+  // exactly). Per key, the best match of each template.
+  using Key = std::tuple<int, int, int, long>;
+  std::map<Key, std::map<int, ClusterMember>> groups;
+  for (const Match& m : matches) {
+    const int b = index.bankOf(m.template_id);
+    const int local = m.template_id - index.first[static_cast<std::size_t>(b)];
+    const BankTemplate& t = banks[static_cast<std::size_t>(b)].templates[static_cast<std::size_t>(local)];
+    ClusterMember member{local, m.x, m.y, m.similarity, static_cast<float>(m.x) + t.anchor_x,
+                         static_cast<float>(m.y) + t.anchor_y};
+    const Key key{b, static_cast<int>(std::floor(member.centre_y / step)),
+                  static_cast<int>(std::floor(member.centre_x / step)), std::lround(t.distance * 1e4f)};
+    auto& slot = groups[key];
+    auto [it, inserted] = slot.try_emplace(local, member);
+    if (!inserted && member.similarity > it->second.similarity) it->second = member;
+  }
+
+  std::vector<Hypothesis> hypotheses;
+  for (auto& [key, members] : groups) {
+    if (static_cast<int>(members.size()) < params.min_templates) continue;
+    Hypothesis h;
+    h.bank = std::get<0>(key);
+    h.distance = static_cast<float>(std::get<3>(key)) * 1e-4f;
+    double sx = 0, sy = 0;
+    for (auto& [local, m] : members) {
+      sx += m.centre_x;
+      sy += m.centre_y;
+      h.members.push_back(m);
+    }
+    h.x = static_cast<float>(sx / static_cast<double>(members.size()));
+    h.y = static_cast<float>(sy / static_cast<double>(members.size()));
+    std::stable_sort(h.members.begin(), h.members.end(),
+                     [](const ClusterMember& a, const ClusterMember& b) { return a.similarity > b.similarity; });
+    hypotheses.push_back(std::move(h));
+  }
+  return hypotheses;
+}
+
+float projectedDiameter(const Hypothesis& h, const std::vector<TemplateBank>& banks, double fx) {
+  const float d = banks.at(static_cast<std::size_t>(h.bank)).diameter;
+  return h.distance > 0.f ? static_cast<float>(fx) * d / h.distance : 0.f;
+}
+
+std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
+                                          double fx, const NmsParams& params) {
+  if (!(params.radius_px >= 0.f) || !(params.radius_fraction > 0.f))
+    throw InputError("NMS radius must be positive (radius_px >= 0, radius_fraction > 0)");
+  // Best score first; ties broken by position so the order never depends on the input order.
+  std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& a, const Hypothesis& b) {
+    return std::tie(b.score, a.bank, a.y, a.x) < std::tie(a.score, b.bank, b.y, b.x);
+  });
+  std::vector<Hypothesis> kept;
+  for (auto& h : hypotheses) {
+    bool suppressed = false;
+    for (const auto& k : kept) {
+      if (!params.across_objects && k.bank != h.bank) continue;
+      const float r = params.radius_px > 0.f ? params.radius_px
+                                             : params.radius_fraction * std::max(projectedDiameter(h, banks, fx),
+                                                                                 projectedDiameter(k, banks, fx));
+      const float dx = h.x - k.x, dy = h.y - k.y;
+      if (dx * dx + dy * dy < r * r) {
+        suppressed = true;
+        break;
+      }
+    }
+    if (!suppressed) kept.push_back(std::move(h));
+  }
+  return kept;
+}
+
+cv::Rect2f templateBox(const Hypothesis& h, const BankTemplate& t) {
+  const float x = h.x - t.anchor_x + static_cast<float>(t.crop.x0);
+  const float y = h.y - t.anchor_y + static_cast<float>(t.crop.y0);
+  return {x, y, static_cast<float>((t.crop.cols - 1) * t.crop.stride + 1),
+          static_cast<float>((t.crop.rows - 1) * t.crop.stride + 1)};
+}
+
+Eigen::Matrix3f viewingRayRotation(float x, float y, const Camera& camera) {
+  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
+                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  return Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), ray.normalized()).toRotationMatrix();
+}
+
+}  // namespace vkpose

@@ -1,0 +1,118 @@
+// Stage 4 on the GPU: the crops of every scored member, one record per member and the
+// scene depth go up in one batch; shaders/cluster_score.comp scores each member in one
+// invocation; the member scores come back and are combined on the CPU.
+#include <bit>
+#include <cstring>
+#include <unordered_map>
+
+#include "gpu/batch.hpp"
+#include "hypotheses/cluster_score_math.hpp"
+
+namespace vkpose {
+namespace gpu {
+
+struct ScorePush {
+  float fx, fy, cx, cy;
+  int32_t width, height;
+  uint32_t member_count;
+  int32_t normal_step;
+  float max_jump;
+  float depth_cap;
+};
+
+class ClusterScoreKernels {
+ public:
+  explicit ClusterScoreKernels(const GpuContext& c)
+      : ctx(c),
+        kernel(c, ShaderId::cluster_score, 4, sizeof(ScorePush), {},
+               {{0, vk::Format::eR32G32Uint}, {1, vk::Format::eR32G32B32A32Uint}, {2, vk::Format::eR32Uint}}) {}
+  const GpuContext& ctx;
+  Kernel kernel;
+  Buffer cells, members, depth, scores;
+};
+
+}  // namespace gpu
+
+ClusterScorer::ClusterScorer(const GpuContext& ctx) : gpu_(std::make_unique<gpu::ClusterScoreKernels>(ctx)) {}
+ClusterScorer::~ClusterScorer() = default;
+
+void ClusterScorer::score(std::vector<Hypothesis>& hypotheses, const std::vector<TemplateBank>& banks,
+                          const ScoreScene& scene, const ScoreParams& params) {
+  scoreMembers(hypotheses, banks, scene, params);
+  combineMemberScores(hypotheses, params);
+}
+
+void ClusterScorer::scoreMembers(std::vector<Hypothesis>& hypotheses, const std::vector<TemplateBank>& banks,
+                                 const ScoreScene& scene, const ScoreParams& params) {
+  validateScoreParams(params);
+  // Each distinct template's crop goes up once, however many hypotheses hold it.
+  std::vector<uint32_t> cells;  // 2 words per cell
+  std::unordered_map<uint64_t, uint32_t> first_cell;
+  std::vector<uint32_t> records;  // 16 words per member
+  for (auto& h : hypotheses) {
+    const auto& bank = banks.at(static_cast<std::size_t>(h.bank));
+    const Eigen::Matrix3f ray = viewingRayRotation(h.x, h.y, scene.camera);
+    h.member_scores.assign(score::scoredMembers(h, params), {});
+    for (std::size_t m = 0; m < h.member_scores.size(); ++m) {
+      const int ti = h.members[m].template_index;
+      const BankTemplate& t = bank.templates.at(static_cast<std::size_t>(ti));
+      const uint64_t key = (static_cast<uint64_t>(h.bank) << 32) | static_cast<uint32_t>(ti);
+      auto [it, inserted] = first_cell.try_emplace(key, static_cast<uint32_t>(cells.size() / 2));
+      if (inserted) {
+        const TemplateCrop& c = t.crop;
+        for (std::size_t k = 0; k < c.depth_01mm.size(); ++k) {
+          uint32_t n = 0;
+          for (int a = 0; a < 3; ++a) n |= static_cast<uint32_t>(static_cast<uint8_t>(c.normals[3 * k + a])) << (8 * a);
+          cells.push_back(c.depth_01mm[k]);
+          cells.push_back(n);
+        }
+      }
+      const score::MemberPlacement at = score::placeMember(h, t);
+      auto f = [](float v) { return std::bit_cast<uint32_t>(v); };
+      const uint32_t record[16] = {it->second,
+                                   static_cast<uint32_t>(t.crop.cols) | (static_cast<uint32_t>(t.crop.rows) << 16),
+                                   static_cast<uint32_t>(t.crop.stride), 0u,
+                                   static_cast<uint32_t>(at.x0), static_cast<uint32_t>(at.y0), f(ray(0, 0)), f(ray(0, 1)),
+                                   f(ray(0, 2)), f(ray(1, 0)), f(ray(1, 1)), f(ray(1, 2)),
+                                   f(ray(2, 0)), f(ray(2, 1)), f(ray(2, 2)), 0u};
+      records.insert(records.end(), std::begin(record), std::end(record));
+    }
+  }
+  const std::size_t member_count = records.size() / 16;
+  if (member_count == 0) return;
+
+  auto& g = *gpu_;
+  const cv::Mat& depth = scene.depth_m;
+  CV_Assert(depth.type() == CV_32FC1 && depth.isContinuous());
+  g.cells.reserve(g.ctx, cells.size() * 4);
+  g.members.reserve(g.ctx, records.size() * 4);
+  g.depth.reserve(g.ctx, depth.total() * 4);
+  g.scores.reserve(g.ctx, member_count * 32);
+  gpu::Batch batch(g.ctx);
+  batch.upload(g.cells, cells.data(), cells.size() * 4);
+  batch.upload(g.members, records.data(), records.size() * 4);
+  batch.upload(g.depth, depth.data, depth.total() * 4);
+  const gpu::ScorePush push{static_cast<float>(scene.camera.fx), static_cast<float>(scene.camera.fy),
+                            static_cast<float>(scene.camera.cx), static_cast<float>(scene.camera.cy),
+                            depth.cols, depth.rows, static_cast<uint32_t>(member_count), params.normal_step_px,
+                            params.normal_max_jump_m, params.depth_cap_m};
+  const auto groups = gpu::groups2DFor(member_count, 64);
+  batch.dispatch(g.kernel, {g.cells, g.members, g.depth, g.scores}, push, groups.x, groups.y);
+  std::vector<uint32_t> out(member_count * 8);
+  batch.download(g.scores, out.data(), out.size() * 4);
+  batch.submit();
+
+  std::size_t m = 0;
+  for (auto& h : hypotheses)
+    for (auto& s : h.member_scores) {
+      const uint32_t* o = &out[8 * m++];
+      s.object_cells = static_cast<int>(o[0]);
+      s.depth_pairs = static_cast<int>(o[1]);
+      s.normal_pairs = static_cast<int>(o[2]);
+      s.depth_offset = std::bit_cast<float>(o[4]);
+      s.depth_error = std::bit_cast<float>(o[5]);
+      s.angle_error = std::bit_cast<float>(o[6]);
+    }
+}
+
+}  // namespace vkpose
