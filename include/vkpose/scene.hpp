@@ -29,8 +29,8 @@ struct SceneRendering {
 /// Renders every object (one GPU renderer per distinct mesh) and keeps the nearest surface.
 SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>& objects, const Camera& camera);
 
-/// A flat square of side `size` metres in the object's x-y plane, facing +z, `grey` 0..1:
-/// a table under the objects.
+/// A flat square of side `size` metres in the object's x-y plane, centred at its origin,
+/// `grey` 0..1: a table under or behind the objects.
 Mesh planeMesh(float size, float grey = 0.55f);
 
 /// Structured-light depth noise: axial Gaussian noise growing with distance squared,

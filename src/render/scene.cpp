@@ -1,4 +1,5 @@
 // Synthetic multi-object scenes and sensor noise.
+#include <cmath>
 #include <map>
 #include <random>
 
@@ -52,13 +53,23 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
 }
 
 Mesh planeMesh(float size, float grey) {
-  if (!(size > 0.f)) throw InputError("plane size must be positive");
+  if (!(size > 0.f) || size > 100.f) throw InputError("plane size must be in (0, 100] metres");
+  // Tiles of at most 5 cm: the rasterizer drops a triangle with a corner far outside the
+  // image instead of clipping it, so a large plane must be made of small pieces.
+  const int n = std::max(1, static_cast<int>(std::ceil(size / 0.05f)));
   Mesh m;
   m.name = "plane";
-  const float h = 0.5f * size;
-  m.vertices = {{-h, -h, 0.f}, {h, -h, 0.f}, {h, h, 0.f}, {-h, h, 0.f}};
-  m.faces = {{0, 1, 2}, {0, 2, 3}};
-  m.colours.assign(4, Eigen::Vector3f::Constant(grey));
+  const float step = size / static_cast<float>(n), h = 0.5f * size;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      m.vertices.emplace_back(-h + static_cast<float>(j) * step, -h + static_cast<float>(i) * step, 0.f);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      m.faces.emplace_back(a, b, d);
+      m.faces.emplace_back(a, d, c);
+    }
+  m.colours.assign(m.vertices.size(), Eigen::Vector3f::Constant(grey));
   finishMesh(m);
   return m;
 }

@@ -1,0 +1,296 @@
+// Stages 3-5: template clustering, the cluster score (GPU against the CPU reference) and
+// non-maximum suppression, on hand-made inputs and on synthetic scenes with known instances.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "hypotheses/cluster_score_math.hpp"
+#include "test_support.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/scene.hpp"
+
+namespace vkpose {
+namespace {
+
+// A bank of `n` fake templates whose object centre sits at (10, 20) from the template's
+// top-left, at the given training distances (cycled).
+TemplateBank fakeBank(int n, std::vector<float> distances, float diameter = 0.1f) {
+  TemplateBank b;
+  b.object = "fake";
+  b.diameter = diameter;
+  for (int i = 0; i < n; ++i) {
+    BankTemplate t;
+    t.anchor_x = 10.f;
+    t.anchor_y = 20.f;
+    t.distance = distances[static_cast<std::size_t>(i) % distances.size()];
+    b.templates.push_back(t);
+  }
+  return b;
+}
+
+TEST(TemplateIndex, LocatesGlobalIdsInTheirBanks) {
+  const std::vector<TemplateBank> banks{fakeBank(3, {0.5f}), fakeBank(0, {0.5f}), fakeBank(5, {0.5f})};
+  const TemplateIndex index(banks);
+  EXPECT_EQ(index.bankOf(0), 0);
+  EXPECT_EQ(index.bankOf(2), 0);
+  EXPECT_EQ(index.bankOf(3), 2);  // bank 1 is empty
+  EXPECT_EQ(index.localId(7), 4);
+  EXPECT_THROW(index.bankOf(8), InputError);
+  EXPECT_THROW(index.bankOf(-1), InputError);
+}
+
+TEST(Clustering, GroupsByCellAndDistanceAndDropsSmallClusters) {
+  // Templates 0..5 at 0.5 m, 6..8 at 0.6 m (distances cycle over 6 + 3 ids below).
+  TemplateBank bank = fakeBank(9, {0.5f});
+  for (int i = 6; i < 9; ++i) bank.templates[static_cast<std::size_t>(i)].distance = 0.6f;
+  const std::vector<TemplateBank> banks{bank};
+  // Centres = match + (10, 20). Cell size 12: centres (100..107, 200..203) share cell (16, 8).
+  std::vector<Match> matches{
+      {0, 90, 180, 90.f, 0}, {1, 92, 181, 85.f, 0}, {2, 96, 183, 88.f, 0},  // cell A, 0.5 m
+      {2, 97, 183, 95.f, 0},                                                // template 2 again, better
+      {6, 90, 180, 90.f, 0}, {7, 91, 180, 90.f, 0}, {8, 92, 180, 90.f, 0},  // cell A, 0.6 m
+      {3, 300, 300, 90.f, 0}, {4, 301, 300, 90.f, 0},                       // far away: 2 templates only
+  };
+  ClusterParams params;
+  params.position_step_px = 12;
+  params.min_templates = 3;
+  const auto hyps = clusterTemplates(matches, banks, params);
+  ASSERT_EQ(hyps.size(), 2u);
+  // Deterministic order: by cell, then distance.
+  EXPECT_FLOAT_EQ(hyps[0].distance, 0.5f);
+  EXPECT_FLOAT_EQ(hyps[1].distance, 0.6f);
+  ASSERT_EQ(hyps[0].members.size(), 3u);  // template 2 counted once, with its best match
+  EXPECT_EQ(hyps[0].members[0].template_index, 2);
+  EXPECT_FLOAT_EQ(hyps[0].members[0].similarity, 95.f);
+  EXPECT_FLOAT_EQ(hyps[0].x, (100.f + 102.f + 107.f) / 3.f);
+  EXPECT_FLOAT_EQ(hyps[0].y, (200.f + 201.f + 203.f) / 3.f);
+  params.min_templates = 2;
+  EXPECT_EQ(clusterTemplates(matches, banks, params).size(), 3u);
+  params.position_step_px = 0;
+  EXPECT_THROW(clusterTemplates(matches, banks, params), InputError);
+}
+
+Hypothesis scored(float x, float y, float score, int bank = 0) {
+  Hypothesis h;
+  h.bank = bank;
+  h.x = x;
+  h.y = y;
+  h.score = score;
+  h.distance = 0.5f;
+  return h;
+}
+
+TEST(Nms, KeepsTheBestWithinTheRadiusAroundFixedCentres) {
+  const std::vector<TemplateBank> banks{fakeBank(1, {0.5f}), fakeBank(1, {0.5f})};
+  NmsParams p;
+  p.radius_px = 30.f;
+  // The best in the middle suppresses both neighbours.
+  auto kept = suppressNonMaxima({scored(100, 100, 0.5f), scored(125, 100, 0.9f), scored(150, 100, 0.7f)}, banks, 500, p);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_FLOAT_EQ(kept[0].x, 125.f);
+  EXPECT_FLOAT_EQ(kept[0].score, 0.9f);
+  // A (best) and B overlap, B and C overlap, A and C do not: greedy NMS keeps A and C (B is
+  // suppressed, so it suppresses nothing), and nothing moves.
+  kept = suppressNonMaxima({scored(100, 100, 0.9f), scored(125, 100, 0.7f), scored(150, 100, 0.5f)}, banks, 500, p);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_FLOAT_EQ(kept[0].x, 100.f);
+  EXPECT_FLOAT_EQ(kept[1].x, 150.f);
+  // Across objects by default; per object when asked.
+  EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f, 0), scored(110, 100, 0.8f, 1)}, banks, 500, p).size(), 1u);
+  p.across_objects = false;
+  EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f, 0), scored(110, 100, 0.8f, 1)}, banks, 500, p).size(), 2u);
+  // Automatic radius: half the projected diameter (0.1 m at 0.5 m with fx 500: 100 px).
+  p = {};
+  EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f), scored(149, 100, 0.8f)}, banks, 500, p).size(), 1u);
+  EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f), scored(151, 100, 0.8f)}, banks, 500, p).size(), 2u);
+}
+
+TEST(ViewingRay, TurnsTheOpticalAxisOntoThePixelsRay) {
+  Camera cam;
+  for (auto [x, y] : {std::pair{0.f, 0.f}, {639.f, 479.f}, {cam.cx, cam.cy}, {100.f, 400.f}}) {
+    const Eigen::Vector3f axis = viewingRayRotation(x, y, cam) * Eigen::Vector3f::UnitZ();
+    const Eigen::Vector2f p = cam.project(axis);
+    EXPECT_NEAR(p.x(), x, 1e-3);
+    EXPECT_NEAR(p.y(), y, 1e-3);
+  }
+  // At a Kinect image's corner the ray is about 34 degrees off the axis.
+  const Eigen::AngleAxisf corner(viewingRayRotation(0, 0, cam));
+  EXPECT_NEAR(corner.angle() * 180 / 3.14159265f, 34.f, 2.f);
+}
+
+// --------------------------------------------------------------------------------------
+// Synthetic scenes: instances of the coffee cup rendered at training views moved onto the
+// rays of chosen pixels, in front of a table plane, with sensor noise. (A flat-faced part
+// seen face-on is a poor LINEMOD subject: the direction of a face-on normal is noise.)
+
+struct SyntheticScene {
+  std::vector<Eigen::Vector2f> centres;  ///< projected object centres of the instances
+  LinemodFrame frame;
+  Camera camera;
+};
+
+const Mesh& cupMesh() {
+  static const Mesh mesh = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl");
+  return mesh;
+}
+
+const TemplateBank& cupBank() {
+  static const TemplateBank bank = [] {
+    TrainingParams params;
+    // Dense enough that an instance matches tau_c = 3 neighbouring templates.
+    params.views.viewpoints = 60;
+    params.views.radii = {0.6f, 0.7f, 0.1f};
+    params.views.inplane_deg = {-20.f, 20.f, 10.f};
+    return trainTemplates(test::context(), cupMesh(), params);
+  }();
+  return bank;
+}
+
+SyntheticScene cupScene(const std::vector<Eigen::Vector2f>& pixels, unsigned seed) {
+  static const Mesh table = planeMesh(3.f, 0.35f);
+  const Mesh& part = cupMesh();
+  const TemplateBank& bank = cupBank();
+  SyntheticScene s;
+  s.camera = bank.params.camera;
+  std::mt19937 rng(seed);
+  std::vector<SceneObject> objects;
+  Pose table_pose;
+  table_pose.t = {0.f, 0.f, 0.9f};
+  objects.push_back({&table, table_pose});
+  for (const auto& px : pixels) {
+    const auto& t = bank.templates[std::uniform_int_distribution<std::size_t>(0, bank.templates.size() - 1)(rng)];
+    const Eigen::Matrix3f ray = viewingRayRotation(px.x(), px.y(), s.camera);
+    Pose p;
+    p.R = ray * t.pose.R;
+    p.t = ray * t.pose.t;
+    objects.push_back({&part, p});
+    s.centres.push_back(s.camera.project(p.R * bank.centre + p.t));
+  }
+  s.frame = sensorFrame(renderScene(test::context(), objects, s.camera), {}, seed);
+  return s;
+}
+
+TEST(ClusterScore, GpuMatchesTheCpuReference) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::vector<TemplateBank> banks{cupBank()};
+  const SyntheticScene s = cupScene({{200, 150}, {450, 300}, {120, 400}}, 3);
+  LinemodMatcher matcher(test::context(), banks[0].params.features);
+  matcher.setTemplates(concatenateTemplates(banks));
+  std::vector<Hypothesis> ref = clusterTemplates(matcher.match(s.frame), banks);
+  ASSERT_GE(ref.size(), 3u);
+  // A hole in the depth map over one instance: its members must find no pairs there.
+  LinemodFrame holed{s.frame.bgr, s.frame.depth_mm.clone()};
+  cv::circle(holed.depth_mm, cv::Point(120, 400), 60, cv::Scalar(0), cv::FILLED);
+  for (const LinemodFrame* frame : {&s.frame, static_cast<const LinemodFrame*>(&holed)}) {
+    const ScoreScene scene = makeScoreScene(frame->depth_mm, s.camera);
+    ScoreParams params;
+    params.max_members = 0;
+    std::vector<Hypothesis> gpu = ref;
+    scoreMembersReference(ref, banks, scene, params);
+    ClusterScorer scorer(test::context());
+    scorer.scoreMembers(gpu, banks, scene, params);
+    std::size_t members = 0, with_normals = 0;
+    for (std::size_t h = 0; h < ref.size(); ++h) {
+      ASSERT_EQ(gpu[h].member_scores.size(), ref[h].member_scores.size());
+      for (std::size_t m = 0; m < ref[h].member_scores.size(); ++m) {
+        const MemberScore &a = ref[h].member_scores[m], &b = gpu[h].member_scores[m];
+        ++members;
+        with_normals += a.normal_pairs > 0;
+        // Counts are exact; float sums within rounding (acos and the order of the GPU's
+        // fused operations differ in the last bits).
+        EXPECT_EQ(a.object_cells, b.object_cells);
+        EXPECT_EQ(a.depth_pairs, b.depth_pairs);
+        EXPECT_NEAR(a.normal_pairs, b.normal_pairs, 1);
+        EXPECT_NEAR(a.depth_offset, b.depth_offset, 2e-6f);
+        EXPECT_NEAR(a.depth_error, b.depth_error, 2e-6f);
+        EXPECT_NEAR(a.angle_error, b.angle_error, 2e-3f);
+      }
+    }
+    EXPECT_GT(members, 50u);
+    EXPECT_GT(with_normals, members / 2);
+  }
+}
+
+TEST(ClusterScore, TheTrueTemplateAtTheTruePlaceScoresHighAndAMisplacedOneLow) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const TemplateBank& bank = cupBank();
+  const SyntheticScene s = cupScene({{320, 240}}, 11);
+  const ScoreScene scene = makeScoreScene(s.frame.depth_mm, s.camera);
+  // Which template made the instance: the same seed draws the same one.
+  std::mt19937 rng(11);
+  const auto ti = std::uniform_int_distribution<std::size_t>(0, bank.templates.size() - 1)(rng);
+  const BankTemplate& t = bank.templates[ti];
+  Hypothesis h;
+  h.x = s.centres[0].x();
+  h.y = s.centres[0].y();
+  const ScoreParams p;
+  const Eigen::Matrix3f ray = viewingRayRotation(h.x, h.y, s.camera);
+  const MemberScore good = score::scoreMember(t, score::placeMember(h, t), ray, scene, p);
+  EXPECT_GT(good.depth_pairs, good.object_cells * 9 / 10);
+  EXPECT_LT(good.depth_error, 0.002f);  // noise and 1 mm quantization
+  EXPECT_LT(good.angle_error, 0.3f);    // 2-pixel normals on quantized depth
+  h.x += 25.f;                          // a third of the part off
+  const MemberScore bad = score::scoreMember(t, score::placeMember(h, t), ray, scene, p);
+  EXPECT_GT(bad.depth_error, 3 * good.depth_error);
+  EXPECT_GT(bad.angle_error, good.angle_error);
+}
+
+TEST(Detector, FindsEachInstanceOfASyntheticSceneOnceAndNothingElse) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::vector<Eigen::Vector2f> pixels{{150, 130}, {330, 120}, {500, 160}, {200, 350}, {420, 360}};
+  for (unsigned seed : {1u, 2u}) {
+    const SyntheticScene s = cupScene(pixels, seed);
+    Detector detector(test::context(), {cupBank()});
+    const DetectionResult r = detector.detect(s.frame, s.camera);
+    ASSERT_EQ(r.detections.size(), pixels.size()) << "seed " << seed;
+    std::vector<int> found(pixels.size(), 0);
+    for (const Detection& d : r.detections) {
+      int nearest = -1;
+      float best = 1e9f;
+      for (std::size_t i = 0; i < s.centres.size(); ++i) {
+        const float dist = (s.centres[i] - Eigen::Vector2f(d.x, d.y)).norm();
+        if (dist < best) best = dist, nearest = static_cast<int>(i);
+      }
+      // Within 15 % of the cup's projected diameter (about 120 px) of an instance's centre.
+      EXPECT_LT(best, 18.f) << "a detection at " << d.x << "," << d.y << " is on no instance";
+      ++found[static_cast<std::size_t>(nearest)];
+      EXPECT_GT(d.score, detector.params().min_score);
+      EXPECT_TRUE(d.bbox.contains(cv::Point2f(d.x, d.y)));
+      // The template's pose, turned onto the ray, puts the centre where it was found and
+      // at about the right distance.
+      const Eigen::Vector3f c = d.pose.R * cupBank().centre + d.pose.t;
+      EXPECT_LT((s.camera.project(c) - Eigen::Vector2f(d.x, d.y)).norm(), 1.f);
+    }
+    for (int f : found) EXPECT_EQ(f, 1) << "seed " << seed;
+    // Stage timings, in pipeline order.
+    std::vector<std::string> stages;
+    for (const auto& [name, ms] : r.timings_ms) stages.push_back(name);
+    EXPECT_NE(std::find(stages.begin(), stages.end(), "clustering"), stages.end());
+    EXPECT_NE(std::find(stages.begin(), stages.end(), "scoring"), stages.end());
+    EXPECT_EQ(stages.back(), "total");
+  }
+}
+
+TEST(Detector, RejectsFramesItCannotUse) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  Detector detector(test::context(), {cupBank()});
+  const SyntheticScene s = cupScene({{320, 240}}, 5);
+  LinemodFrame empty{s.frame.bgr, s.frame.depth_mm.clone()};
+  empty.depth_mm.setTo(0);
+  EXPECT_THROW(detector.detect(empty, s.camera), InputError);
+  Camera wrong = s.camera;
+  wrong.cx = 5000;
+  EXPECT_THROW(detector.detect(s.frame, wrong), InputError);
+  EXPECT_THROW(Detector(test::context(), {}), InputError);
+  // A hole where the instance is: no crash, no detection there.
+  LinemodFrame holed{s.frame.bgr, s.frame.depth_mm.clone()};
+  cv::circle(holed.depth_mm, cv::Point(320, 240), 90, cv::Scalar(0), cv::FILLED);
+  for (const Detection& d : detector.detect(holed, s.camera).detections)
+    EXPECT_GT(std::hypot(d.x - 320.f, d.y - 240.f), 60.f);
+}
+
+}  // namespace
+}  // namespace vkpose
