@@ -1,0 +1,147 @@
+// `vkpose detect` end to end on the real IC-BIN cup frame, and the detection JSON's fields.
+#include <filesystem>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.hpp"
+#include "vkpose/detection_io.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/frame_io.hpp"
+
+namespace vkpose {
+namespace {
+
+/// The default bank of the coffee cup for the IC-BIN camera (what `vkpose train` makes),
+/// cached in the build folder between runs: training takes most of a minute on 2 cores.
+const TemplateBank& icbinCupBank() {
+  static const TemplateBank bank = [] {
+    const std::string cache = std::string(VKPOSE_TEST_CACHE_DIR) + "/coffee_cup_icbin.vkpb";
+    const Mesh mesh = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl");
+    TrainingParams params;
+    params.camera = loadCamera(test::sharedData() + "/icbin/camera.json");
+    params.symmetric = true;
+    if (std::filesystem::exists(cache)) {
+      try {
+        TemplateBank cached = loadBank(cache);
+        if (cached.mesh_hash == mesh.file_hash && cached.templates.size() == 14040) return cached;
+      } catch (const InputError&) {
+        // A stale or damaged cache: train again.
+      }
+    }
+    TemplateBank b = trainTemplates(test::context(), mesh, params);
+    // Written aside and renamed: tests in other processes may read the cache meanwhile.
+    std::filesystem::create_directories(VKPOSE_TEST_CACHE_DIR);
+    const std::string partial = cache + "." + std::to_string(::getpid()) + ".part";
+    saveBank(b, partial);
+    std::filesystem::rename(partial, cache);
+    return b;
+  }();
+  return bank;
+}
+
+struct IcbinResult {
+  DetectionResult result;
+  std::string json;
+};
+
+const IcbinResult& icbinScene2() {
+  static const IcbinResult r = [] {
+    const std::string d = test::sharedData() + "/icbin/";
+    const Camera camera = loadCamera(d + "camera.json");
+    const LinemodFrame frame = loadFrame(d + "scene2/rgb/0000.png", d + "scene2/depth/0000.png", camera.depth_scale);
+    Detector detector(test::context(), {icbinCupBank()});
+    IcbinResult out;
+    out.result = detector.detect(frame, camera);
+    out.json = detectionJson(out.result, {"rgb.png", "depth.png", test::context().device().name});
+    return out;
+  }();
+  return r;
+}
+
+TEST(DetectIcbin, FindsTheCupsOncePerCupAndNothingOnTheTableOrMarkers) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const auto& dets = icbinScene2().result.detections;
+  // About 17 cups, many half hidden; the clearly visible ones must be there.
+  EXPECT_GE(dets.size(), 8u);
+  EXPECT_LE(dets.size(), 17u);
+  // Centres of cups checked by hand on scene2/rgb/0000.png (pixels): the standing cup in
+  // the middle, the cup on the left, the cup at the front, and two lids seen from above at
+  // the back.
+  const std::vector<cv::Point2f> cups{{345, 242}, {194, 303}, {349, 341}, {332, 170}, {257, 162}};
+  for (const auto& c : cups) {
+    bool found = false;
+    for (const auto& d : dets) found = found || std::hypot(d.x - c.x, d.y - c.y) < 20.f;
+    EXPECT_TRUE(found) << "no detection on the cup at " << c;
+  }
+  // The pile lies within this box; the table, the markers and the cable are outside it.
+  const cv::Rect2f pile(160, 110, 320, 300);
+  for (const auto& d : dets) {
+    EXPECT_TRUE(pile.contains({d.x, d.y})) << d.object << " detected off the pile at " << d.x << "," << d.y;
+    EXPECT_EQ(d.object, "coffee_cup");
+    EXPECT_GE(d.templates, 3);
+  }
+  // No duplicates: no two detections on one cup.
+  for (std::size_t i = 0; i < dets.size(); ++i)
+    for (std::size_t j = i + 1; j < dets.size(); ++j)
+      EXPECT_GT(std::hypot(dets[i].x - dets[j].x, dets[i].y - dets[j].y), 30.f) << i << " and " << j;
+  // Best first.
+  for (std::size_t i = 1; i < dets.size(); ++i) EXPECT_GE(dets[i - 1].score, dets[i].score);
+}
+
+TEST(DetectIcbin, WritesTheDetectionJsonScriptsRelyOn) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const auto doc = nlohmann::json::parse(icbinScene2().json);
+  EXPECT_EQ(doc.at("rgb"), "rgb.png");
+  EXPECT_EQ(doc.at("depth"), "depth.png");
+  EXPECT_FALSE(doc.at("device").get<std::string>().empty());
+  const auto& dets = doc.at("detections");
+  ASSERT_EQ(dets.size(), icbinScene2().result.detections.size());
+  for (const auto& d : dets) {
+    EXPECT_EQ(d.at("object"), "coffee_cup");
+    EXPECT_GT(d.at("score").get<double>(), 0.0);
+    EXPECT_LE(d.at("score").get<double>(), 1.0);
+    ASSERT_EQ(d.at("bbox").size(), 4u);
+    EXPECT_GT(d.at("bbox")[2].get<double>(), 20.0);
+    ASSERT_EQ(d.at("R").size(), 9u);
+    ASSERT_EQ(d.at("t").size(), 3u);
+    // A rotation, row-major; t in metres in front of the camera at the pile's distance.
+    Eigen::Matrix3d R;
+    for (int k = 0; k < 9; ++k) R(k / 3, k % 3) = d.at("R")[static_cast<std::size_t>(k)].get<double>();
+    EXPECT_NEAR((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-4);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-4);
+    const double z = d.at("t")[2].get<double>();
+    EXPECT_GT(z, 0.5);
+    EXPECT_LT(z, 1.0);
+    EXPECT_GE(d.at("templates").get<int>(), 3);
+  }
+  // Per-stage timings.
+  const auto& t = doc.at("timings_ms");
+  for (const char* stage : {"features+similarity", "clustering", "scoring", "nms", "total"}) {
+    ASSERT_TRUE(t.contains(stage)) << stage;
+    EXPECT_GE(t.at(stage).get<double>(), 0.0);
+  }
+}
+
+TEST(DetectionIo, RefusesToOverwriteWithoutForce) {
+  const auto dir = std::filesystem::temp_directory_path() / "vkpose_detect_io_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "det.json").string();
+  std::filesystem::remove(path);
+  writeTextFile(path, "{}\n", false);
+  EXPECT_THROW(writeTextFile(path, "{\"x\": 1}\n", false), InputError);
+  writeTextFile(path, "{\"x\": 1}\n", true);
+  const cv::Mat image(8, 8, CV_8UC3, cv::Scalar(1, 2, 3));
+  const std::string png = (dir / "overlay.png").string();
+  std::filesystem::remove(png);
+  writeImage(png, drawDetections(image, {}), false);
+  EXPECT_THROW(writeImage(png, image, false), InputError);
+  EXPECT_THROW(writeImage((dir / "missing" / "x.png").string(), image, true), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vkpose
