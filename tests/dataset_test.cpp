@@ -35,17 +35,6 @@ json readJsonFile(const fs::path& p) { return json::parse(readText(p)); }
 
 void writeJsonFile(const fs::path& p, const json& j) { writeText(p, j.dump(1)); }
 
-/// The message of the InputError `f` throws; fails the test when it throws nothing.
-std::string inputErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError";
-  return {};
-}
-
 void expectMentions(const std::string& message, std::initializer_list<std::string> parts) {
   for (const auto& p : parts)
     EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' missing from: " << message;
@@ -133,7 +122,7 @@ TEST(Dataset, LmoModelsInfoInMetresWithSymmetries) {
 TEST(Dataset, IcbinIsNotABopDataset) {
   VKPOSE_REQUIRE_SHARED_DATA();
   // IC-BIN here is frames and a camera file only: the reader says what is missing.
-  expectMentions(inputErrorOf([] { loadBopDataset(test::sharedData() + "/icbin"); }), {"models_info.json"});
+  expectMentions(test::inputErrorOf([] { loadBopDataset(test::sharedData() + "/icbin"); }), {"models_info.json"});
   const Camera c = loadCamera(test::sharedData() + "/icbin/camera.json");
   EXPECT_DOUBLE_EQ(c.fx, 550.0);
   EXPECT_DOUBLE_EQ(c.cy, 244.0);
@@ -168,7 +157,7 @@ class DatasetBrokenBop : public ::testing::Test {
     writeJsonFile(p, j);
   }
   std::string loadError() {
-    return inputErrorOf([&] { loadBopDataset(root.string()); });
+    return test::inputErrorOf([&] { loadBopDataset(root.string()); });
   }
 };
 
@@ -188,7 +177,7 @@ TEST_F(DatasetBrokenBop, MissingFiles) {
   expectMentions(loadError(), {"depth", "000003.png"});
   writeText(scene / "depth" / "000003.png", "stand-in");
 
-  expectMentions(inputErrorOf([&] { loadBopDataset(root.string(), "val"); }), {"val", "split"});
+  expectMentions(test::inputErrorOf([&] { loadBopDataset(root.string(), "val"); }), {"val", "split"});
   fs::remove(scene / "scene_camera.json");
   expectMentions(loadError(), {"scene_camera.json"});
   fs::remove(scene / "scene_gt.json");
@@ -332,7 +321,7 @@ class DatasetBrokenTejani : public ::testing::Test {
     std::ofstream out(p);
     for (const auto& l : copy) out << l << '\n';
     out.close();
-    return inputErrorOf([&] { loadTejaniPoses(p.string()); });
+    return test::inputErrorOf([&] { loadTejaniPoses(p.string()); });
   }
 };
 
@@ -366,7 +355,7 @@ TEST_F(DatasetBrokenTejani, GarbageNaNAndNonRotations) {
   expectMentions(errorWith({{2, "-1 0 0 0"}, {3, "0 1 0 0"}, {4, "0 0 1 1"}}), {"lines 2-5 (pose 0)", "det R = -1"});
   expectMentions(errorWith({{13, "0 0 0.5 1"}}), {"lines 10-13 (pose 2)", "last row"});
   expectMentions(errorWith({}, 0), {"poses1010.txt", "empty"});
-  expectMentions(inputErrorOf([&] { loadTejaniPoses((dir / "absent.txt").string()); }), {"absent.txt", "cannot open"});
+  expectMentions(test::inputErrorOf([&] { loadTejaniPoses((dir / "absent.txt").string()); }), {"absent.txt", "cannot open"});
 }
 
 }  // namespace

@@ -34,16 +34,6 @@ Eigen::Matrix3f rotation(float degrees, const Eigen::Vector3f& axis) {
   return Eigen::AngleAxisf(degrees * std::numbers::pi_v<float> / 180.f, axis.normalized()).toRotationMatrix();
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError";
-  return {};
-}
-
 // ---------------------------------------------------------------------------------------
 // Pose errors on synthetic point sets
 
@@ -194,13 +184,13 @@ TEST_F(MetricsMatching, BarelyVisibleInstancesCanBeLeftOut) {
 }
 
 TEST_F(MetricsMatching, UnknownObjectsAndNonRotationsAreInputErrors) {
-  EXPECT_NE(errorOf([&] { evaluateImage({est(7, 0.f, 1.f)}, {}, models); }).find("object 7"), std::string::npos);
-  EXPECT_NE(errorOf([&] { evaluateImage({}, {gt(9, 0.f)}, models); }).find("object 9"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([&] { evaluateImage({est(7, 0.f, 1.f)}, {}, models); }).find("object 7"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([&] { evaluateImage({}, {gt(9, 0.f)}, models); }).find("object 9"), std::string::npos);
   auto bad = est(1, 0.f, 1.f);
   bad.R(0, 0) = 3.f;
-  EXPECT_NE(errorOf([&] { evaluateImage({bad}, {gt(1, 0.f)}, models); }).find("not a rotation"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([&] { evaluateImage({bad}, {gt(1, 0.f)}, models); }).find("not a rotation"), std::string::npos);
   auto nan_score = est(1, 0.f, std::nanf(""));
-  EXPECT_NE(errorOf([&] { evaluateImage({nan_score}, {gt(1, 0.f)}, models); }).find("finite"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([&] { evaluateImage({nan_score}, {gt(1, 0.f)}, models); }).find("finite"), std::string::npos);
   EXPECT_THROW(makeEvalModel(modelInfo(3, 0.1f), {}), InputError);
   EXPECT_THROW(makeEvalModel(modelInfo(3, 0.f), {Eigen::Vector3f::Zero()}), InputError);
 }
@@ -301,7 +291,7 @@ TEST_F(MetricsLmo, GroundTruthAsEstimatesScoresPerfectly) {
   const EvalSummary nothing = evaluateDataset(*dataset, *models, {});
   EXPECT_EQ(nothing.mean.fn, 8);
   EXPECT_EQ(nothing.mean.recall, 0.0);
-  EXPECT_NE(errorOf([&] {
+  EXPECT_NE(test::inputErrorOf([&] {
               evaluateDataset(*dataset, *models, {{2, 4, gtEstimates()[0], -1}});
             }).find("image 4"),
             std::string::npos);
@@ -459,7 +449,7 @@ TEST(Metrics, BopCsvLinesAreBopToolkits) {
   const std::string good = "0,3,5,0.5,1 0 0 0 1 0 0 0 1,1 2 1000,-1";
   const auto check = [&](const std::string& bad_line, std::initializer_list<std::string> parts) {
     std::ofstream(p) << "scene_id,im_id,obj_id,score,R,t,time\n" << good << '\n' << bad_line << '\n';
-    const std::string msg = errorOf([&] { loadBopResults(p.string()); });
+    const std::string msg = test::inputErrorOf([&] { loadBopResults(p.string()); });
     for (const auto& part : parts) EXPECT_NE(msg.find(part), std::string::npos) << part << " missing from: " << msg;
   };
   check("0,3,5,0.5,1 0 0 0 1 0 0 0 1,1 2 1000", {p.filename().string(), "line 3", "6 comma-separated columns"});
@@ -471,7 +461,7 @@ TEST(Metrics, BopCsvLinesAreBopToolkits) {
   check("0,3,5,0.5,1 0 0 0 1 0 0 0 1,1 x 1000,-1", {"line 3", "'t'"});
   check("0,3,5,0.5,1 0 0 0 1 0 0 0 1,1 2 1000,", {"line 3", "'time'"});
   fs::remove(p);
-  EXPECT_NE(errorOf([&] { loadBopResults(p.string()); }).find("cannot open"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([&] { loadBopResults(p.string()); }).find("cannot open"), std::string::npos);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <random>
 
+#include "vkpose/error.hpp"
 #include "vkpose/frame_io.hpp"
 #include "vkpose/opencv_linemod.hpp"
 
@@ -41,6 +42,16 @@ std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const Feat
 GpuContext& context() {
   static GpuContext ctx;
   return ctx;
+}
+
+std::string inputErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return {};
 }
 
 }  // namespace vkpose::test

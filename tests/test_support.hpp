@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers of the test suites: the real frames in ../shared/data, skipping with a
 // clear message when it is absent, and LINEMOD templates cut from a frame.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +25,9 @@ LinemodFrame icbinFrame();
 /// random boxes); `count` at most.
 std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const FeatureParams& params, int count,
                                            unsigned seed = 1);
+
+/// The message of the InputError `f` throws; fails the test when it throws nothing.
+std::string inputErrorOf(const std::function<void()>& f);
 
 /// One Vulkan context shared by all tests of a process (lavapipe in CI).
 GpuContext& context();
