@@ -4,15 +4,14 @@
 
 #include <fmt/format.h>
 
+#include "util/timing.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose {
 
 namespace {
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using util::msSince;
 
 bool sameFeatures(const FeatureParams& a, const FeatureParams& b) {
   return a.T == b.T && a.use_colour == b.use_colour && a.use_depth == b.use_depth;

@@ -3,15 +3,14 @@
 
 #include "match/frame_features_gpu.hpp"
 #include "match/similarity_gpu.hpp"
+#include "util/timing.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/matcher.hpp"
 
 namespace vkpose {
 
 namespace {
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using util::msSince;
 }  // namespace
 
 LinemodMatcher::LinemodMatcher(GpuContext& context, FeatureParams feature_params, MatchParams params)

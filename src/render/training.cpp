@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "util/parallel.hpp"
+#include "util/timing.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/template_bank.hpp"
 
@@ -260,9 +261,7 @@ Camera trainingCamera(const Mesh& mesh, const TrainingParams& params, const std:
 
 namespace {
 
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using util::msSince;
 
 }  // namespace
 
