@@ -21,8 +21,8 @@ struct RefineParams {
   int mls_polynomial_order = 2;  ///< 2: quadric fit (follows curved surfaces); 1: plane
   /// true: fit MLS only at one seed point per voxel_size voxel (the neighbourhoods still hold
   /// every point), since the voxel grid keeps one point per voxel anyway: the same smoothing
-  /// for several times less work. false: fit at every point, then voxel-filter (the paper's
-  /// literal order).
+  /// for about a third of the work (LM-O crop of 8.8k points: 23 vs 68 ms). false: fit at
+  /// every point, then voxel-filter (the paper's literal order).
   bool mls_at_voxel_seeds = true;
   /// Both clouds are voxel-filtered to this leaf size (metres), so that each surface patch
   /// weighs the same in the fit whatever the sensor's or the model's sampling. 0: no filter.
