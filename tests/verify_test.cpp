@@ -1,0 +1,161 @@
+// Pose verification (stage 8): the collision rate of the posed model's visible points against
+// an octree of the scene.
+#include <iostream>
+#include <limits>
+#include <random>
+
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include "cloud_support.hpp"
+#include "mesh_support.hpp"
+#include "test_support.hpp"
+#include "vkpose/camera.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/mesh.hpp"
+#include "vkpose/refine.hpp"
+#include "vkpose/verify.hpp"
+#include "vkpose/views.hpp"
+
+namespace vkpose {
+namespace {
+
+/// The L-shaped mesh at 0.7 m in a crop with 1 mm noise and a background 5 cm behind.
+struct Scene {
+  Mesh mesh = test::lShapeMesh();
+  Camera camera;
+  Pose truth;
+  PointCloud scene;
+  Scene() {
+    const TrainingView v = lookAtView({0.4f, -0.5f, 0.75f}, mesh.centroid, 0.7f, 20.f);
+    truth = {v.R, v.t};
+    std::mt19937 rng(3);
+    scene = test::syntheticCrop(mesh, camera, truth, 0.001f, 0.f, rng);
+  }
+  PointCloud visibleAt(const Pose& pose) const { return test::visibleSurface(mesh, camera, pose); }
+};
+
+TEST(Verify, CorrectPoseCollidesAlmostEverywhere) {
+  const Scene s;
+  const VerifyResult r = verifyPose(s.visibleAt(s.truth), s.scene);
+  std::cout << fmt::format("correct pose: phi {:.3f} ({} of {} model points, {} scene points), {:.2f} ms\n",
+                           r.collision_rate, r.hits, r.model_points, r.scene_points, r.ms);
+  EXPECT_GT(r.collision_rate, 0.9f);
+  EXPECT_TRUE(r.accepted);
+  EXPECT_GT(r.model_points, 1000u);
+  EXPECT_GT(r.scene_points, s.scene.size() / 2);  // the object and the background near it
+}
+
+// Towards the camera nothing collides; sideways the L's long bar still overlaps itself a
+// little (measured phi 0.08).
+TEST(Verify, PoseShiftedByThreeCentimetresCollidesAlmostNowhere) {
+  const Scene s;
+  const Eigen::Vector3f to_camera = -s.truth.t.normalized();
+  const Eigen::Vector3f sideways = to_camera.cross(Eigen::Vector3f::UnitY()).normalized();
+  for (const Eigen::Vector3f& shift : {Eigen::Vector3f(0.03f * to_camera), Eigen::Vector3f(0.03f * sideways),
+                                       Eigen::Vector3f(-0.03f * sideways)}) {
+    const Pose wrong{s.truth.R, s.truth.t + shift};
+    const VerifyResult r = verifyPose(s.visibleAt(wrong), s.scene);
+    std::cout << fmt::format("shifted by ({:.3f}, {:.3f}, {:.3f}): phi {:.3f}\n", shift.x(), shift.y(), shift.z(),
+                             r.collision_rate);
+    EXPECT_LT(r.collision_rate, 0.12f);
+    EXPECT_FALSE(r.accepted);
+  }
+}
+
+// The scene lacks the half of the object left of its centre (an occluder cut it away): about
+// the share of model points on that side no longer collide.
+TEST(Verify, HalfOccludedObjectCollidesAboutHalf) {
+  const Scene s;
+  const PointCloud model = s.visibleAt(s.truth);
+  const float cut_x = s.truth.R.row(0).dot(s.mesh.centroid) + s.truth.t.x();
+  PointCloud half;
+  for (const auto& p : s.scene)
+    if (p.x() >= cut_x) half.push_back(p);
+  const auto kept = std::count_if(model.begin(), model.end(), [&](const auto& p) { return p.x() >= cut_x; });
+  const float expected = float(kept) / float(model.size());
+  const VerifyResult r = verifyPose(model, half);
+  std::cout << fmt::format("half occluded: phi {:.3f}, model share on the kept side {:.3f}\n", r.collision_rate,
+                           expected);
+  EXPECT_GT(expected, 0.3f);
+  EXPECT_LT(expected, 0.7f);
+  EXPECT_NEAR(r.collision_rate, expected, 0.08f);
+}
+
+TEST(Verify, WholeFrameGivesTheSameRateAsTheCrop) {
+  const Scene s;
+  PointCloud frame = s.scene;
+  for (int i = 0; i < 1000; ++i) frame.emplace_back(-0.3f + 0.0005f * i, 0.2f, 1.2f);  // far away
+  const PointCloud model = s.visibleAt(s.truth);
+  const VerifyResult crop = verifyPose(model, s.scene), whole = verifyPose(model, frame);
+  EXPECT_EQ(whole.hits, crop.hits);
+  EXPECT_EQ(whole.scene_points, crop.scene_points);
+}
+
+TEST(Verify, EmptyInputsAreRejected) {
+  const Scene s;
+  const PointCloud model = s.visibleAt(s.truth);
+  const PointCloud nan(10, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  for (const auto& [m, sc] : {std::pair{model, PointCloud{}}, std::pair{PointCloud{}, s.scene},
+                              std::pair{PointCloud{}, PointCloud{}}, std::pair{nan, s.scene}, std::pair{model, nan}}) {
+    VerifyResult r;
+    ASSERT_NO_THROW(r = verifyPose(m, sc));
+    EXPECT_EQ(r.collision_rate, 0.f);
+    EXPECT_EQ(r.hits, 0u);
+    EXPECT_FALSE(r.accepted);
+  }
+  VerifyParams bad;
+  bad.resolution = 0.f;
+  EXPECT_THROW(verifyPose(model, s.scene, bad), InputError);
+}
+
+TEST(Verify, AcceptsAboveTheThresholdOnly) {
+  const Scene s;
+  const PointCloud model = s.visibleAt(s.truth);
+  const float phi = verifyPose(model, s.scene).collision_rate;
+  VerifyParams p;
+  p.threshold = phi - 0.01f;
+  EXPECT_TRUE(verifyPose(model, s.scene, p).accepted);
+  p.threshold = phi;
+  EXPECT_FALSE(verifyPose(model, s.scene, p).accepted);
+}
+
+// Real depth: LM-O scene 2 frame 3, object 5 against the whole frame. Kinect noise and a
+// depth bias of a median 6 mm behind the ground-truth model (see refine_test.cpp) leave few
+// model points in occupied 4 mm leaves even at the right pose. Measured at 4 mm: ground truth
+// 0.20, ICP-refined 0.50, refined shifted 1 cm 0.09-0.31, 2 cm 0.02-0.15; at 8 mm: 0.60,
+// 0.77, 0.31-0.60, 0.08-0.35. So the default threshold (0.5) rejects this correct detection
+// half the time; resolution and threshold are to be tuned on data, as VerifyParams says.
+TEST(Verify, RealFrameRanksRefinedPoseAboveShiftedOnes) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string dir = test::sharedData() + "/lmo_scene2_frame3/";
+  const Mesh mesh = loadMesh(dir + "models/obj_000005.ply", MeshUnits::Millimetres);
+  const Camera camera = loadCamera(dir + "camera.json");
+  const cv::Mat depth_mm = test::lmoFrame().depth_mm;
+  Pose truth;  // scene_gt.json, image 3, obj_id 5
+  const float R[9] = {0.94893088f, 0.30725587f, -0.07208124f, 0.24200515f, -0.85502122f,
+                      -0.45872652f, -0.20257109f, 0.41784038f, -0.88568011f};
+  truth.R = Eigen::Matrix<float, 3, 3, Eigen::RowMajor>(R);
+  truth.t = Eigen::Vector3f(0.13436598f, 0.04577287f, 0.96478389f);
+  const PointCloud crop = test::backProjectMm(depth_mm, camera, cv::Rect(366, 216, 80, 111));  // bbox_visib + 10 px
+  const PointCloud frame = test::backProjectMm(depth_mm, camera);
+  const Pose refined =
+      refinePose(test::transformed(test::visibleSurface(mesh, camera, truth), test::inverse(truth)), crop, truth).pose;
+
+  const VerifyResult at_truth = verifyPose(test::visibleSurface(mesh, camera, truth), frame);
+  const VerifyResult at_refined = verifyPose(test::visibleSurface(mesh, camera, refined), frame);
+  std::cout << fmt::format("real frame ({} points): phi at ground truth {:.3f}, refined {:.3f}, {:.2f} ms\n",
+                           frame.size(), at_truth.collision_rate, at_refined.collision_rate, at_refined.ms);
+  EXPECT_GT(at_refined.collision_rate, 0.4f);
+  EXPECT_GT(at_refined.collision_rate, at_truth.collision_rate);
+  EXPECT_LT(at_refined.scene_points, frame.size() / 20);  // cropped to the model's box
+  for (int axis = 0; axis < 3; ++axis) {
+    Pose shifted = refined;
+    shifted.t[axis] += 0.02f;
+    const float phi = verifyPose(test::visibleSurface(mesh, camera, shifted), frame).collision_rate;
+    EXPECT_LT(phi, 0.5f * at_refined.collision_rate) << "shifted 2 cm along axis " << axis;
+  }
+}
+
+}  // namespace
+}  // namespace vkpose
