@@ -137,7 +137,7 @@ TEST(DetectionIo, RefusesToOverwriteWithoutForce) {
   const cv::Mat image(8, 8, CV_8UC3, cv::Scalar(1, 2, 3));
   const std::string png = (dir / "overlay.png").string();
   std::filesystem::remove(png);
-  writeImage(png, drawDetections(image, {}), false);
+  writeImage(png, drawDetections(image, {}, {}, Camera{}), false);
   EXPECT_THROW(writeImage(png, image, false), InputError);
   EXPECT_THROW(writeImage((dir / "missing" / "x.png").string(), image, true), InputError);
   std::filesystem::remove_all(dir);

@@ -155,7 +155,12 @@ TEST(Bank, RoundTripsAndRejectsDamagedFiles) {
   EXPECT_EQ(back.object, bank.object);
   EXPECT_EQ(back.mesh_hash, bank.mesh_hash);
   EXPECT_FLOAT_EQ(back.diameter, bank.diameter);
-  ASSERT_EQ(back.templates.size(), bank.templates.size());
+  // The mesh travels with the bank (version 2): the pose stages render it.
+  ASSERT_EQ(back.mesh.vertices.size(), bank.mesh.vertices.size());
+  ASSERT_GT(back.mesh.faces.size(), 0u);
+  EXPECT_EQ(back.mesh.faces, bank.mesh.faces);
+  EXPECT_EQ(back.mesh.vertices, bank.mesh.vertices);
+  EXPECT_FLOAT_EQ(back.mesh.diameter, bank.mesh.diameter);
   for (std::size_t i = 0; i < bank.templates.size(); ++i) {
     const auto &a = bank.templates[i], &b = back.templates[i];
     EXPECT_EQ(a.pose.R, b.pose.R);

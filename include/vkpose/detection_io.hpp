@@ -15,17 +15,29 @@ struct DetectionSource {
 };
 
 /// The detection JSON document: {"rgb", "depth", "device", "detections": [{"object", "score",
-/// "bbox": [x, y, w, h], "R": [9, row-major], "t": [metres], "templates", ...}],
-/// "timings_ms": {stage: ms}}, pretty-printed.
+/// "bbox": [x, y, w, h], "R": [9, row-major], "t": [metres], "collision_rate", "icp_fitness",
+/// "templates", ...}], "rejected": [the same, with "reason"], "timings_ms": {stage: ms}},
+/// pretty-printed.
 std::string detectionJson(const DetectionResult& result, const DetectionSource& source);
 
 /// Writes `text` to `path`; InputError when the file exists and `overwrite` is false, or
 /// when it cannot be written.
 void writeTextFile(const std::string& path, const std::string& text, bool overwrite);
 
-/// The colour image with a box, a label (object and score) and the centre of every
-/// detection, a colour per object, and a legend.
-cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result);
+struct OverlayOptions {
+  bool show_rejected = false;  ///< also draw the hypotheses stages 6-8 rejected, in red
+};
+
+/// The colour image with every detection drawn in its object's colour: for a refined pose the
+/// projected model outline and its axes (x red, y green, z blue), otherwise the template's box
+/// and centre; a label (index, object, score, collision rate) and a legend. `banks` and
+/// `camera` are the detector's (the meshes and the intrinsics the poses refer to).
+cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                       const Camera& camera, const OverlayOptions& options = {});
+
+/// The outer contours of a mesh projected at `pose`, in pixels (its silhouette; no depth test
+/// is needed for that).
+std::vector<std::vector<cv::Point>> silhouette(const Mesh& mesh, const Pose& pose, const Camera& camera);
 
 /// Writes an image (PNG); InputError when the file exists and `overwrite` is false, or when
 /// it cannot be written.

@@ -1,8 +1,9 @@
 #pragma once
 // The detector facade: chains the stages (features and similarity on the GPU, clustering,
-// cluster score, NMS) for several objects at once and records the time of each stage. It
-// owns no algorithm of its own; every stage is callable alone (hypotheses.hpp,
-// cluster_score.hpp, matcher.hpp).
+// cluster score, NMS, initial pose, refinement, verification) for several objects at once and
+// records the time of each stage. It owns no algorithm of its own; every stage is callable
+// alone (matcher.hpp, hypotheses.hpp, cluster_score.hpp, initial_pose.hpp, refine.hpp,
+// verify.hpp).
 #include <memory>
 #include <string>
 #include <utility>
@@ -10,7 +11,10 @@
 
 #include "vkpose/cluster_score.hpp"
 #include "vkpose/hypotheses.hpp"
+#include "vkpose/initial_pose.hpp"
 #include "vkpose/matcher.hpp"
+#include "vkpose/refine.hpp"
+#include "vkpose/verify.hpp"
 #include "vkpose/template_bank.hpp"
 
 namespace vkpose {
@@ -23,7 +27,21 @@ struct DetectorParams {
   /// Hypotheses whose cluster score gamma is below this are dropped before NMS (a cluster on
   /// clutter, a template that fits the colour edges but not the depth).
   float min_score = 0.15f;
+  /// Stages 6-8 (initial pose, MLS + ICP, octree verification). false: stop after NMS and
+  /// report the best template's pose, unverified.
+  bool estimate_poses = true;
+  InitialPoseParams initial_pose;
+  RefineParams refine;
+  VerifyParams verify;
+  /// Two accepted poses whose object centres are closer than this fraction of the smaller
+  /// diameter claim the same space: only the better one is kept (two clusters of one
+  /// instance that NMS kept apart in the image converge to one place after ICP).
+  float duplicate_fraction = 0.3f;
+  unsigned threads = 0;  ///< CPU threads for the per-hypothesis stages (0: all cores)
 };
+
+/// Throws InputError naming the first bad value of any stage.
+void validateDetectorParams(const DetectorParams& params);
 
 /// One detected object instance.
 struct Detection {
@@ -33,10 +51,17 @@ struct Detection {
   float alpha = 0.f, beta = 0.f;
   float x = 0.f, y = 0.f;     ///< image position of the object's centre
   cv::Rect2f bbox;            ///< pixels: the best template's object box
-  Pose pose;                  ///< the best template's pose, turned onto the viewing ray
+  Pose pose;                  ///< refined pose (or, without stages 6-8, the best template's)
   int templates = 0;          ///< members of the cluster
   int template_index = -1;    ///< the best template (within the bank)
   float similarity = 0.f;     ///< its LINEMOD similarity, percent
+  // Stages 6-8; unset (verified false, collision_rate -1) when they did not run.
+  bool verified = false;       ///< the refined pose passed verification
+  float collision_rate = -1.f; ///< phi
+  double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
+  int icp_iterations = 0;
+  int rotation_votes = 0;      ///< templates in the largest rotation group
+  std::string rejection;       ///< why a hypothesis was rejected (empty when accepted)
 };
 
 /// Milliseconds per stage, in pipeline order.
@@ -44,6 +69,7 @@ using StageTimings = std::vector<std::pair<std::string, double>>;
 
 struct DetectionResult {
   std::vector<Detection> detections;  ///< best score first
+  std::vector<Detection> rejected;    ///< hypotheses that stages 6-8 rejected, with the reason
   StageTimings timings_ms;
   std::size_t matches = 0, hypotheses = 0, scored_hypotheses = 0;  ///< counts after stages 2, 3, 4
   std::vector<std::string> warnings;  ///< e.g. a bank trained for another focal length
@@ -70,6 +96,9 @@ class Detector {
   DetectorParams params_;
   std::unique_ptr<LinemodMatcher> matcher_;
   std::unique_ptr<ClusterScorer> scorer_;
+  std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stage 6
+
+  void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, DetectionResult& result);
 };
 
 /// The pose a hypothesis's template implies: the template's rotation turned onto the viewing

@@ -61,6 +61,9 @@ struct RefineResult {
   double mls_ms = 0, voxel_ms = 0, icp_ms = 0;     ///< time per step
 };
 
+/// Throws InputError naming the bad value.
+void validateRefineParams(const RefineParams& params);
+
 /// Refines `initial` so that `model_points` (object frame, metres) fall onto `scene_points`
 /// (camera-frame crop, metres). Pass the model's surface as seen from about the initial pose
 /// (rendered there and moved to the object frame), as stage 6 has it: with all mesh vertices,

@@ -66,6 +66,9 @@ struct TemplateBank {
   float diameter = 0.f;      ///< metres
   bool symmetric = false;
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  ///< the point the cameras look at (object frame)
+  /// The mesh the bank was trained from (metres): the pose stages render it and compare it
+  /// with the scene, so a bank file is all that detection needs.
+  Mesh mesh;
   TrainingParams params;
   std::vector<BankTemplate> templates;
 
@@ -110,7 +113,7 @@ ExtractedTemplate extractTemplate(const Rendering& rendering, const TrainingPara
 
 /// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
 /// FNV-1a 64 checksum of everything before it.
-constexpr uint32_t kBankVersion = 1;
+constexpr uint32_t kBankVersion = 2;  // 2: the mesh is stored
 void saveBank(const TemplateBank& bank, const std::string& path);
 /// Throws InputError naming the file and the problem: missing, not a bank, another version,
 /// truncated, or a checksum mismatch.

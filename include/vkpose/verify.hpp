@@ -26,6 +26,9 @@ struct VerifyResult {
   double ms = 0;
 };
 
+/// Throws InputError naming the bad value.
+void validateVerifyParams(const VerifyParams& params);
+
 /// visible_model_points: camera-frame points of the model surface as the camera sees it at the
 /// pose under test. scene_points: camera-frame scene points (a crop or the whole frame).
 /// Non-finite points are ignored; empty inputs give phi = 0, rejected. Thread-safe.

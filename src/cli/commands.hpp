@@ -15,6 +15,7 @@ enum ExitCode { kOk = 0, kBadInput = 1, kUsage = 2, kNoDevice = 3 };
 struct GlobalOptions {
   int device = -1;  ///< -1: automatic
   bool quiet = false;
+  bool verbose = false;  ///< print more detail (e.g. every rejected hypothesis and why)
   GpuOptions gpu() const {
     GpuOptions o;
     if (device >= 0) o.device_index = device;

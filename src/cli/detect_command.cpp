@@ -19,6 +19,7 @@ namespace {
 struct DetectOptions {
   std::vector<std::string> banks;
   std::string rgb, depth, camera, camera_entry, out, overlay;
+  OverlayOptions overlay_options;
   double depth_scale = 0;  // 0: the camera file's
   bool force = false;
   DetectorParams params;
@@ -41,7 +42,10 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                   "Millimetres per depth-PNG unit (default: the camera file's depth_scale, else 1)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--out", opt->out, "Detection JSON to write");
-  sub->add_option("--overlay", opt->overlay, "Overlay PNG to write (boxes, labels, scores)");
+  sub->add_option("--overlay", opt->overlay,
+                  "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)");
+  sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
+                "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
   sub->add_flag("--force", opt->force, "Overwrite --out and --overlay if they exist");
   auto* stages = "Stage parameters";
   sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
@@ -73,6 +77,27 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str()
       ->group(stages);
+  sub->add_flag("!--no-pose", p.estimate_poses,
+                "Stop after NMS: report the best template's pose, without refinement or verification")
+      ->group(stages);
+  sub->add_option("--rotation-cluster", p.initial_pose.rotation_cluster_deg,
+                  "Initial pose: template rotations closer than this vote together (tau_theta), degrees")
+      ->check(CLI::Range(0.1, 180.0))
+      ->capture_default_str()
+      ->group(stages);
+  sub->add_option("--icp-voxel", p.refine.voxel_size, "Refinement: voxel grid of scene and model, metres (0: none)")
+      ->check(CLI::Range(0.0, 0.1))
+      ->capture_default_str()
+      ->group(stages);
+  sub->add_option("--octree-resolution", p.verify.resolution, "Verification: octree leaf size, metres")
+      ->check(CLI::Range(0.0005, 0.1))
+      ->capture_default_str()
+      ->group(stages);
+  sub->add_option("--min-collision", p.verify.threshold,
+                  "Verification: a pose is accepted when its collision rate phi exceeds this, 0..1")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(stages);
   return [opt, &global]() {
     for (const auto* path : {&opt->out, &opt->overlay})
       if (!path->empty() && !opt->force && std::filesystem::exists(*path))
@@ -96,17 +121,23 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
     fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
                result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
                result.scored_hypotheses, opt->params.min_score, ctx.device().name);
-    if (!result.detections.empty()) {
-      fmt::print("  {:>3}  {:<16} {:>6} {:>6} {:>6}  {:>20}  {:>9}\n", "#", "object", "score", "alpha", "beta",
-                 "box x,y,w,h (px)", "distance");
-      for (std::size_t i = 0; i < result.detections.size(); ++i) {
-        const Detection& d = result.detections[i];
-        fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6.3f}  {:>20}  {:>7.3f} m\n", i + 1, d.object, d.score,
-                   d.alpha, d.beta,
+    if (!result.rejected.empty())
+      fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
+                 result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");
+    auto table = [](const std::vector<Detection>& dets, bool reasons) {
+      fmt::print("  {:>3}  {:<16} {:>6} {:>6} {:>6}  {:>20}  {:>24}  {}\n", "#", "object", "score", "gamma", "phi",
+                 "box x,y,w,h (px)", "t (m)", reasons ? "why rejected" : "icp fitness (mm^2)");
+      for (std::size_t i = 0; i < dets.size(); ++i) {
+        const Detection& d = dets[i];
+        fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6}  {:>20}  {:>24}  {}\n", i + 1, d.object, d.score, d.alpha * d.beta,
+                   d.collision_rate >= 0.f ? fmt::format("{:.3f}", d.collision_rate) : "-",
                    fmt::format("{:.0f},{:.0f},{:.0f},{:.0f}", d.bbox.x, d.bbox.y, d.bbox.width, d.bbox.height),
-                   d.pose.t.norm());
+                   fmt::format("{:.3f},{:.3f},{:.3f}", d.pose.t.x(), d.pose.t.y(), d.pose.t.z()),
+                   reasons ? d.rejection : (d.collision_rate >= 0.f ? fmt::format("{:.2f}", d.icp_fitness * 1e6) : "-"));
       }
-    }
+    };
+    if (!result.detections.empty()) table(result.detections, false);
+    if (global.verbose && !result.rejected.empty()) table(result.rejected, true);
     if (!global.quiet) {
       fmt::print("timings (ms):");
       for (const auto& [stage, ms] : result.timings_ms) fmt::print(" {} {:.1f}", stage, ms);
@@ -117,7 +148,11 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       if (!global.quiet) fmt::print("wrote {}\n", opt->out);
     }
     if (!opt->overlay.empty()) {
-      writeImage(opt->overlay, drawDetections(frame.bgr, result), opt->force);
+      Camera image_camera = camera;  // scene_camera.json entries carry no size: the frame's
+      image_camera.width = frame.bgr.cols;
+      image_camera.height = frame.bgr.rows;
+      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), image_camera, opt->overlay_options),
+                 opt->force);
       if (!global.quiet) fmt::print("wrote {}\n", opt->overlay);
     }
     return kOk;

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   app.add_option("--device", global.device, "Vulkan device index (see 'vkpose info'); also VKPOSE_DEVICE")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", global.quiet, "Print only results and errors");
+  app.add_flag("-v,--verbose", global.verbose, "Print more detail (e.g. why each rejected hypothesis was rejected)");
   app.footer(
       "Exit codes: 0 ok, 1 bad input (missing or corrupt file, bad value), 2 usage error, 3 no usable Vulkan "
       "device.");

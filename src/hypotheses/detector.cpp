@@ -1,9 +1,11 @@
-// The detector facade: stages 1-5 in order, a timing per stage.
+// The detector facade: stages 1-8 in order, a timing per stage.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
 
+#include "util/parallel.hpp"
 #include "util/timing.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
@@ -16,6 +18,53 @@ using util::msSince;
 bool sameFeatures(const FeatureParams& a, const FeatureParams& b) {
   return a.T == b.T && a.use_colour == b.use_colour && a.use_depth == b.use_depth;
 }
+
+/// What stages 1-5 know about a hypothesis (no pose yet).
+Detection hypothesisDetection(const Hypothesis& h, const std::vector<TemplateBank>& banks) {
+  const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
+  const ClusterMember& m = h.members[static_cast<std::size_t>(h.best_member)];
+  Detection d;
+  d.bank = h.bank;
+  d.object = bank.object;
+  d.score = h.score;
+  d.alpha = h.alpha;
+  d.beta = h.beta;
+  d.x = h.x;
+  d.y = h.y;
+  d.bbox = templateBox(h, bank.templates[static_cast<std::size_t>(m.template_index)]);
+  d.templates = static_cast<int>(h.members.size());
+  d.template_index = m.template_index;
+  d.similarity = m.similarity;
+  return d;
+}
+
+PointCloud transformed(const PointCloud& object_points, const Pose& pose) {
+  PointCloud out;
+  out.reserve(object_points.size());
+  for (const auto& p : object_points) out.push_back(pose.R * p + pose.t);
+  return out;
+}
+
+/// The image box and centre of the posed visible model.
+void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vector3f& centre, const Camera& camera) {
+  cv::Rect2f box;
+  bool first = true;
+  for (const auto& p : model_points) {
+    const Eigen::Vector3f c = d.pose.R * p + d.pose.t;
+    if (!(c.z() > 0.f)) continue;
+    const Eigen::Vector2f uv = camera.project(c);
+    const cv::Rect2f px(uv.x(), uv.y(), 1.f, 1.f);
+    box = first ? px : (box | px);
+    first = false;
+  }
+  if (!first) d.bbox = box;
+  const Eigen::Vector3f c = d.pose.R * centre + d.pose.t;
+  if (c.z() > 0.f) {
+    const Eigen::Vector2f uv = camera.project(c);
+    d.x = uv.x();
+    d.y = uv.y();
+  }
+}
 }  // namespace
 
 Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorParams params)
@@ -27,8 +76,7 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
       throw InputError("banks '" + banks_.front().object + "' and '" + b.object +
                        "' were trained with different pyramids or modalities; retrain one of them");
   }
-  validateScoreParams(params_.score);
-  if (!(params_.min_score >= 0.f && params_.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
+  validateDetectorParams(params_);
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
   matcher_->setTemplates(concatenateTemplates(banks_));
   scorer_ = std::make_unique<ClusterScorer>(ctx_);
@@ -36,18 +84,22 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 
 Detector::~Detector() = default;
 
+void validateDetectorParams(const DetectorParams& p) {
+  validateScoreParams(p.score);
+  if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
+  validateInitialPoseParams(p.initial_pose);
+  validateRefineParams(p.refine);
+  validateVerifyParams(p.verify);
+  if (!(p.duplicate_fraction >= 0.f && p.duplicate_fraction <= 10.f))
+    throw InputError(fmt::format("the duplicate distance must be in [0, 10] diameters, not {}", p.duplicate_fraction));
+}
+
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera) {
-  const Eigen::Matrix3f ray = viewingRayRotation(h.x, h.y, camera);
   // The training camera looked at the bank's centre, so the centre sits on the template's
   // optical axis; on the scene's ray it moves by the measured depth offset.
-  const Eigen::Vector3f centre_t = t.pose.R * bank.centre + t.pose.t;
-  const float range = centre_t.norm();
-  const Eigen::Vector3f centre_s = ray * centre_t * ((range + s.depth_offset) / range);
-  Pose p;
-  p.R = ray * t.pose.R;
-  p.t = centre_s - p.R * bank.centre;
-  return p;
+  const float range = (t.pose.R * bank.centre + t.pose.t).norm() + s.depth_offset;
+  return poseAtRange(viewingRayRotation(h.x, h.y, camera) * t.pose.R, h.x, h.y, range, bank.centre, camera);
 }
 
 DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_camera) {
@@ -97,28 +149,146 @@ DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_
   hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, params_.nms);
   result.timings_ms.emplace_back("nms", msSince(t0));
 
-  for (const auto& h : hypotheses) {
-    const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
-    const auto best = static_cast<std::size_t>(h.best_member);
-    const ClusterMember& m = h.members[best];
-    const BankTemplate& t = bank.templates[static_cast<std::size_t>(m.template_index)];
-    Detection d;
-    d.bank = h.bank;
-    d.object = bank.object;
-    d.score = h.score;
-    d.alpha = h.alpha;
-    d.beta = h.beta;
-    d.x = h.x;
-    d.y = h.y;
-    d.bbox = templateBox(h, t);
-    d.pose = templatePose(h, h.member_scores[best], t, bank, camera);
-    d.templates = static_cast<int>(h.members.size());
-    d.template_index = m.template_index;
-    d.similarity = m.similarity;
-    result.detections.push_back(std::move(d));
+  if (params_.estimate_poses) {
+    estimatePoses(hypotheses, scene, result);
+  } else {
+    for (const auto& h : hypotheses) {
+      Detection d = hypothesisDetection(h, banks_);
+      const auto best = static_cast<std::size_t>(h.best_member);
+      const BankTemplate& t = banks_[static_cast<std::size_t>(h.bank)].templates[static_cast<std::size_t>(d.template_index)];
+      d.pose = templatePose(h, h.member_scores[best], t, banks_[static_cast<std::size_t>(h.bank)], camera);
+      result.detections.push_back(std::move(d));
+    }
   }
   result.timings_ms.emplace_back("total", msSince(total0));
   return result;
+}
+
+void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene,
+                             DetectionResult& result) {
+  const Camera& camera = scene.camera;
+  const std::size_t n = hypotheses.size();
+  // Stage 6: rotations, then one render call per bank, then the translations in parallel.
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<Detection> dets(n);
+  std::vector<Pose> rendered(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Hypothesis& h = hypotheses[i];
+    const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
+    const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose);
+    dets[i] = hypothesisDetection(h, banks_);
+    dets[i].rotation_votes = rot.group_size;
+    rendered[i] = poseOnViewingRay(rot.R, h, bank, camera);
+  }
+  if (renderers_.empty())
+    for (const auto& b : banks_) renderers_.push_back(std::make_unique<MeshRenderer>(ctx_, b.mesh));
+  std::vector<Rendering> renderings(n);
+  for (std::size_t b = 0; b < banks_.size(); ++b) {
+    std::vector<std::size_t> which;
+    std::vector<Pose> poses;
+    for (std::size_t i = 0; i < n; ++i)
+      if (static_cast<std::size_t>(hypotheses[i].bank) == b) which.push_back(i), poses.push_back(rendered[i]);
+    if (poses.empty()) continue;
+    std::vector<Rendering> r = renderers_[b]->render(camera, poses);
+    for (std::size_t k = 0; k < which.size(); ++k) renderings[which[k]] = std::move(r[k]);
+  }
+  std::vector<InitialPose> initial(n);
+  util::parallelFor(
+      n,
+      [&](std::size_t i) {
+        const float diameter = banks_[static_cast<std::size_t>(hypotheses[i].bank)].diameter;
+        initial[i] = initialTranslation(renderings[i], rendered[i], scene.depth_m, camera, diameter, params_.initial_pose);
+        renderings[i] = {};  // a full-frame rendering per hypothesis adds up
+      },
+      params_.threads);
+  result.timings_ms.emplace_back("initial_pose", msSince(t0));
+
+  // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).
+  t0 = std::chrono::steady_clock::now();
+  std::vector<PointCloud> smoothed(n);
+  const RefineParams& rp = params_.refine;
+  util::parallelFor(
+      n,
+      [&](std::size_t i) {
+        if (!initial[i].ok) return;
+        smoothed[i] = rp.mls ? smoothMls(initial[i].scene_points, rp.mls_radius, rp.mls_polynomial_order,
+                                         rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f)
+                             : initial[i].scene_points;
+      },
+      params_.threads);
+  result.timings_ms.emplace_back("mls", msSince(t0));
+  t0 = std::chrono::steady_clock::now();
+  RefineParams icp_params = rp;
+  icp_params.mls = false;  // done above
+  std::vector<RefineResult> refined(n);
+  util::parallelFor(
+      n,
+      [&](std::size_t i) {
+        if (initial[i].ok) refined[i] = refinePose(initial[i].model_points, smoothed[i], initial[i].pose, icp_params);
+      },
+      params_.threads);
+  result.timings_ms.emplace_back("icp", msSince(t0));
+
+  // Stage 8: the collision rate of the refined visible model against the raw scene crop.
+  t0 = std::chrono::steady_clock::now();
+  std::vector<VerifyResult> verified(n);
+  util::parallelFor(
+      n,
+      [&](std::size_t i) {
+        if (!initial[i].ok) return;
+        verified[i] = verifyPose(transformed(initial[i].model_points, refined[i].pose), initial[i].scene_points,
+                                 params_.verify);
+      },
+      params_.threads);
+
+  std::vector<Detection> accepted;
+  for (std::size_t i = 0; i < n; ++i) {
+    Detection& d = dets[i];
+    const TemplateBank& bank = banks_[static_cast<std::size_t>(d.bank)];
+    if (!initial[i].ok) {
+      d.pose = rendered[i];
+      d.rejection = initial[i].why;
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    d.pose = refined[i].pose;
+    d.icp_fitness = refined[i].fitness;
+    d.icp_iterations = refined[i].iterations;
+    d.collision_rate = verified[i].collision_rate;
+    placeInImage(d, initial[i].model_points, bank.centre, camera);
+    if (!verified[i].accepted) {
+      d.rejection = fmt::format("collision rate {:.2f} is not above {:.2f}", d.collision_rate,
+                                params_.verify.threshold);
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    d.verified = true;
+    accepted.push_back(std::move(d));
+  }
+  // Two poses in one place: the better one stays (NMS works on image centres; after ICP two
+  // clusters of one instance can meet).
+  std::stable_sort(accepted.begin(), accepted.end(), [](const Detection& a, const Detection& b) { return a.score > b.score; });
+  for (auto& d : accepted) {
+    const TemplateBank& bank = banks_[static_cast<std::size_t>(d.bank)];
+    const Eigen::Vector3f c = d.pose.R * bank.centre + d.pose.t;
+    const Detection* taken = nullptr;
+    for (const auto& k : result.detections) {
+      const TemplateBank& kb = banks_[static_cast<std::size_t>(k.bank)];
+      const float limit = params_.duplicate_fraction * std::min(bank.diameter, kb.diameter);
+      if ((k.pose.R * kb.centre + k.pose.t - c).norm() < limit) {
+        taken = &k;
+        break;
+      }
+    }
+    if (taken) {
+      d.verified = false;
+      d.rejection = fmt::format("the same place as a better {} detection", taken->object);
+      result.rejected.push_back(std::move(d));
+    } else {
+      result.detections.push_back(std::move(d));
+    }
+  }
+  result.timings_ms.emplace_back("verification", msSince(t0));
 }
 
 }  // namespace vkpose

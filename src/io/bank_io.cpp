@@ -1,6 +1,7 @@
 // The template bank file (.vkpb). Layout, little-endian:
 //   "VKPOSEBK"  u32 version  u32 reserved  u64 payload bytes  payload  u64 FNV-1a 64 of all before
-// The payload holds the object, the training parameters and every template (see write()).
+// The payload holds the object, its mesh (version 2: the pose stages render it, so a bank is
+// all detection needs), the training parameters and every template (see writePayload()).
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -93,12 +94,56 @@ SteppedRange readRange(Reader& r) {
   return s;
 }
 
+void writeMesh(Writer& w, const Mesh& mesh) {
+  // Every array with its own count: normals and colours are optional or filled later.
+  for (const auto* v : {&mesh.vertices, &mesh.normals, &mesh.colours}) {
+    w.put(static_cast<uint32_t>(v->size()));
+    w.putArray(*v);
+  }
+  w.put(static_cast<uint32_t>(mesh.faces.size()));
+  w.putArray(mesh.faces);
+}
+
+/// count Eigen 3-vectors stored as 3 * count scalars.
+template <class S>
+std::vector<Eigen::Matrix<S, 3, 1>> getTriples(Reader& r, std::size_t count) {
+  const std::vector<S> flat = r.getArray<S>(3 * count);
+  std::vector<Eigen::Matrix<S, 3, 1>> out(count);
+  for (std::size_t i = 0; i < count; ++i) out[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
+  return out;
+}
+
+Mesh readMesh(Reader& r, const std::string& name) {
+  Mesh mesh;
+  mesh.name = name;
+  mesh.vertices = getTriples<float>(r, r.get<uint32_t>());
+  mesh.normals = getTriples<float>(r, r.get<uint32_t>());
+  mesh.colours = getTriples<float>(r, r.get<uint32_t>());
+  mesh.faces = getTriples<int>(r, r.get<uint32_t>());
+  const auto vertices = mesh.vertices.size();
+  if (vertices < 3 || mesh.faces.empty())
+    r.fail(fmt::format("a mesh with {} vertices and {} faces", vertices, mesh.faces.size()));
+  if ((!mesh.normals.empty() && mesh.normals.size() != vertices) ||
+      (!mesh.colours.empty() && mesh.colours.size() != vertices))
+    r.fail("mesh normals or colours that do not match its vertices");
+  for (const auto& f : mesh.faces)
+    if ((f.array() < 0).any() || (f.array() >= static_cast<int>(vertices)).any())
+      r.fail("a mesh face with a vertex index out of range");
+  try {
+    finishMesh(mesh);
+  } catch (const InputError& e) {
+    r.fail(e.what());
+  }
+  return mesh;
+}
+
 void writePayload(Writer& w, const TemplateBank& bank) {
   w.putString(bank.object);
   w.put(bank.mesh_hash);
   w.put(bank.diameter);
   w.put(static_cast<uint8_t>(bank.symmetric));
   for (int i = 0; i < 3; ++i) w.put(bank.centre[i]);
+  writeMesh(w, bank.mesh);
   const TrainingParams& p = bank.params;
   w.put(static_cast<int32_t>(p.views.viewpoints));
   w.put(static_cast<uint8_t>(p.views.full_sphere));
@@ -154,6 +199,8 @@ TemplateBank readPayload(Reader& r, const std::string& path) {
   bank.diameter = r.get<float>();
   bank.symmetric = r.get<uint8_t>() != 0;
   for (int i = 0; i < 3; ++i) bank.centre[i] = r.get<float>();
+  bank.mesh = readMesh(r, bank.object);
+  bank.mesh.file_hash = bank.mesh_hash;
   TrainingParams& p = bank.params;
   p.views.viewpoints = r.get<int32_t>();
   p.views.full_sphere = r.get<uint8_t>() != 0;

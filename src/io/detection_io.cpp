@@ -31,6 +31,34 @@ cv::Scalar objectColour(int bank) {
                                        {40, 230, 230}, {255, 220, 60}, {120, 60, 255}, {160, 255, 160}};
   return palette[static_cast<std::size_t>(bank) % std::size(palette)];
 }
+
+
+nlohmann::ordered_json detectionEntry(const Detection& d) {
+  nlohmann::ordered_json j;
+  j["object"] = d.object;
+  j["score"] = round(d.score, 4);
+  j["bbox"] = {round(d.bbox.x, 1), round(d.bbox.y, 1), round(d.bbox.width, 1), round(d.bbox.height, 1)};
+  auto R = nlohmann::ordered_json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R.push_back(round(d.pose.R(r, c), 6));
+  j["R"] = R;
+  j["t"] = {round(d.pose.t.x(), 6), round(d.pose.t.y(), 6), round(d.pose.t.z(), 6)};
+  if (d.collision_rate >= 0.f) {
+    j["collision_rate"] = round(d.collision_rate, 4);
+    j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision
+    j["icp_iterations"] = d.icp_iterations;
+    j["rotation_votes"] = d.rotation_votes;
+  }
+  j["verified"] = d.verified;
+  j["templates"] = d.templates;
+  j["alpha"] = round(d.alpha, 4);
+  j["beta"] = round(d.beta, 4);
+  j["centre"] = {round(d.x, 1), round(d.y, 1)};
+  j["template"] = d.template_index;
+  j["similarity"] = round(d.similarity, 2);
+  if (!d.rejection.empty()) j["reason"] = d.rejection;
+  return j;
+}
 }  // namespace
 
 std::string detectionJson(const DetectionResult& result, const DetectionSource& source) {
@@ -39,28 +67,15 @@ std::string detectionJson(const DetectionResult& result, const DetectionSource& 
   doc["depth"] = source.depth;
   doc["device"] = source.device;
   auto dets = nlohmann::ordered_json::array();
-  for (const Detection& d : result.detections) {
-    nlohmann::ordered_json j;
-    j["object"] = d.object;
-    j["score"] = round(d.score, 4);
-    j["bbox"] = {round(d.bbox.x, 1), round(d.bbox.y, 1), round(d.bbox.width, 1), round(d.bbox.height, 1)};
-    auto R = nlohmann::ordered_json::array();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R.push_back(round(d.pose.R(r, c), 6));
-    j["R"] = R;
-    j["t"] = {round(d.pose.t.x(), 6), round(d.pose.t.y(), 6), round(d.pose.t.z(), 6)};
-    j["templates"] = d.templates;
-    j["alpha"] = round(d.alpha, 4);
-    j["beta"] = round(d.beta, 4);
-    j["centre"] = {round(d.x, 1), round(d.y, 1)};
-    j["template"] = d.template_index;
-    j["similarity"] = round(d.similarity, 2);
-    dets.push_back(std::move(j));
-  }
+  for (const Detection& d : result.detections) dets.push_back(detectionEntry(d));
   doc["detections"] = std::move(dets);
+  auto rejected = nlohmann::ordered_json::array();
+  for (const Detection& d : result.rejected) rejected.push_back(detectionEntry(d));
+  doc["rejected"] = std::move(rejected);
   doc["counts"] = {{"matches", result.matches},
                    {"hypotheses", result.hypotheses},
                    {"scored", result.scored_hypotheses},
+                   {"rejected", result.rejected.size()},
                    {"detections", result.detections.size()}};
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, ms] : result.timings_ms) timings[stage] = round(ms, 3);
@@ -75,24 +90,93 @@ void writeTextFile(const std::string& path, const std::string& text, bool overwr
   if (!out || !(out << text) || !out.flush()) throw InputError("cannot write " + path);
 }
 
-cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result) {
-  CV_Assert(bgr.type() == CV_8UC3);
-  cv::Mat out = bgr.clone();
-  // Dim the image a little so the boxes stand out.
-  out.convertTo(out, -1, 0.75, 0);
+std::vector<std::vector<cv::Point>> silhouette(const Mesh& mesh, const Pose& pose, const Camera& camera) {
+  cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8UC1);
+  std::vector<cv::Point> projected(mesh.vertices.size());
+  std::vector<bool> in_front(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f c = pose.R * mesh.vertices[i] + pose.t;
+    in_front[i] = c.z() > 1e-3f;
+    if (!in_front[i]) continue;
+    const Eigen::Vector2f uv = camera.project(c);
+    // Clamped far outside the image: fillConvexPoly works in int and clips itself.
+    projected[i] = {static_cast<int>(std::clamp(uv.x(), -1e5f, 1e5f)), static_cast<int>(std::clamp(uv.y(), -1e5f, 1e5f))};
+  }
+  for (const auto& f : mesh.faces) {
+    if (!in_front[static_cast<std::size_t>(f[0])] || !in_front[static_cast<std::size_t>(f[1])] ||
+        !in_front[static_cast<std::size_t>(f[2])])
+      continue;
+    const cv::Point tri[3] = {projected[static_cast<std::size_t>(f[0])], projected[static_cast<std::size_t>(f[1])],
+                              projected[static_cast<std::size_t>(f[2])]};
+    cv::fillConvexPoly(mask, tri, 3, cv::Scalar(255));
+  }
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  return contours;
+}
+
+namespace {
+void drawLabel(cv::Mat& out, const std::string& label, cv::Point org, const cv::Scalar& colour) {
   const int font = cv::FONT_HERSHEY_SIMPLEX;
-  for (std::size_t i = 0; i < result.detections.size(); ++i) {
-    const Detection& d = result.detections[i];
-    const cv::Scalar colour = objectColour(d.bank);
-    const cv::Rect box(cvRound(d.bbox.x), cvRound(d.bbox.y), cvRound(d.bbox.width), cvRound(d.bbox.height));
+  int baseline = 0;
+  const cv::Size ts = cv::getTextSize(label, font, 0.4, 1, &baseline);
+  org.x = std::clamp(org.x, 0, std::max(0, out.cols - ts.width - 2));
+  org.y = std::max(ts.height + 2, org.y);
+  cv::rectangle(out, org + cv::Point(-1, baseline), org + cv::Point(ts.width + 1, -ts.height - 2), colour, cv::FILLED);
+  cv::putText(out, label, org, font, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+}
+
+/// Outline and axes for a posed detection, box and centre for a template-only one.
+void drawDetection(cv::Mat& out, const Detection& d, const TemplateBank* bank, const Camera& camera,
+                   const cv::Scalar& colour, const std::string& label) {
+  const cv::Rect box(cvRound(d.bbox.x), cvRound(d.bbox.y), cvRound(d.bbox.width), cvRound(d.bbox.height));
+  const bool posed = d.collision_rate >= 0.f && bank && !bank->mesh.faces.empty();
+  if (!posed) {
     cv::rectangle(out, box, colour, 2, cv::LINE_AA);
     cv::drawMarker(out, cv::Point(cvRound(d.x), cvRound(d.y)), colour, cv::MARKER_CROSS, 10, 2, cv::LINE_AA);
-    const std::string label = fmt::format("{} {} {:.2f}", i + 1, d.object, d.score);
-    int baseline = 0;
-    const cv::Size ts = cv::getTextSize(label, font, 0.4, 1, &baseline);
-    const cv::Point org(std::max(0, box.x), std::max(ts.height + 2, box.y - 3));
-    cv::rectangle(out, org + cv::Point(-1, baseline), org + cv::Point(ts.width + 1, -ts.height - 2), colour, cv::FILLED);
-    cv::putText(out, label, org, font, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    drawLabel(out, label, {box.x, box.y - 3}, colour);
+    return;
+  }
+  const auto contours = silhouette(bank->mesh, d.pose, camera);
+  cv::drawContours(out, contours, -1, colour, 2, cv::LINE_AA);
+  const Eigen::Vector3f o = d.pose.R * bank->centre + d.pose.t;
+  const float length = 0.35f * bank->diameter;
+  const cv::Scalar axis_colour[3] = {{40, 40, 255}, {40, 255, 40}, {255, 80, 40}};
+  if (o.z() > 1e-3f) {
+    const Eigen::Vector2f uo = camera.project(o);
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Vector3f e = o + length * d.pose.R.col(a);
+      if (!(e.z() > 1e-3f)) continue;
+      const Eigen::Vector2f ue = camera.project(e);
+      cv::line(out, cv::Point(cvRound(uo.x()), cvRound(uo.y())), cv::Point(cvRound(ue.x()), cvRound(ue.y())),
+               axis_colour[a], 2, cv::LINE_AA);
+    }
+  }
+  drawLabel(out, label, {box.x, box.y - 3}, colour);
+}
+}  // namespace
+
+cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                       const Camera& camera, const OverlayOptions& options) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  cv::Mat out = bgr.clone();
+  // Dim the image a little so the drawing stands out.
+  out.convertTo(out, -1, 0.75, 0);
+  auto bankOf = [&](const Detection& d) {
+    return d.bank >= 0 && static_cast<std::size_t>(d.bank) < banks.size() ? &banks[static_cast<std::size_t>(d.bank)]
+                                                                          : nullptr;
+  };
+  auto labelOf = [](std::size_t index, const Detection& d) {
+    return d.collision_rate >= 0.f ? fmt::format("{} {} {:.2f} phi {:.2f}", index, d.object, d.score, d.collision_rate)
+                                   : fmt::format("{} {} {:.2f}", index, d.object, d.score);
+  };
+  if (options.show_rejected)
+    for (std::size_t i = 0; i < result.rejected.size(); ++i)
+      drawDetection(out, result.rejected[i], bankOf(result.rejected[i]), camera, cv::Scalar(40, 40, 230),
+                    "x " + labelOf(i + 1, result.rejected[i]));
+  for (std::size_t i = 0; i < result.detections.size(); ++i) {
+    const Detection& d = result.detections[i];
+    drawDetection(out, d, bankOf(d), camera, objectColour(d.bank), labelOf(i + 1, d));
   }
   // Legend: detections per object, and what the numbers mean.
   std::map<std::string, std::pair<int, int>> per_object;  // object -> (count, bank)
@@ -101,8 +185,11 @@ cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result) {
     ++e.first;
     e.second = d.bank;
   }
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
   int y = 16;
-  cv::putText(out, fmt::format("{} detections (label: index, object, score gamma)", result.detections.size()),
+  cv::putText(out,
+              fmt::format("{} detections (label: index, object, score, collision rate phi){}", result.detections.size(),
+                          options.show_rejected ? fmt::format("; {} rejected in red", result.rejected.size()) : ""),
               cv::Point(6, y), font, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   for (const auto& [object, e] : per_object) {
     y += 16;

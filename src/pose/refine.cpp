@@ -102,7 +102,9 @@ void checkMls(float radius, int order, float seed_voxel) {
     throw InputError(fmt::format("MLS seed voxel must be >= 0 and finite, got {}", seed_voxel));
 }
 
-void checkParams(const RefineParams& p) {
+}  // namespace
+
+void validateRefineParams(const RefineParams& p) {
   if (p.mls) checkMls(p.mls_radius, p.mls_polynomial_order, 0.f);
   if (!std::isfinite(p.voxel_size) || p.voxel_size < 0.f)
     throw InputError(fmt::format("voxel size must be >= 0 and finite, got {}", p.voxel_size));
@@ -117,6 +119,8 @@ void checkParams(const RefineParams& p) {
     throw InputError(fmt::format("fixed max correspondence distance must be >= 0, got {}",
                                  p.fixed_max_correspondence_m));
 }
+
+namespace {
 
 /// PCL's transformation-epsilon test on one iteration's increment: squared translation and
 /// 1 - cos(rotation angle) both within epsilon.
@@ -258,7 +262,7 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
 
 RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_points, const Pose& initial,
                         const RefineParams& params) {
-  checkParams(params);
+  validateRefineParams(params);
   RefineResult result;
   result.pose = initial;
 

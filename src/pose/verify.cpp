@@ -13,14 +13,18 @@
 
 namespace vkpose {
 
-VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
-                        const VerifyParams& params) {
+void validateVerifyParams(const VerifyParams& params) {
   if (!(params.resolution > 0.f) || !std::isfinite(params.resolution))
     throw InputError(fmt::format("octree resolution must be positive and finite, got {}", params.resolution));
   if (!(params.crop_margin >= 0.f) || !std::isfinite(params.crop_margin))
     throw InputError(fmt::format("verification crop margin must be >= 0 and finite, got {}", params.crop_margin));
   if (!std::isfinite(params.threshold))
     throw InputError(fmt::format("collision rate threshold must be finite, got {}", params.threshold));
+}
+
+VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
+                        const VerifyParams& params) {
+  validateVerifyParams(params);
 
   const auto t0 = std::chrono::steady_clock::now();
   VerifyResult result;

@@ -283,6 +283,7 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
   bank.diameter = mesh.diameter;
   bank.symmetric = params.symmetric;
   bank.centre = mesh.bboxCentre();
+  bank.mesh = mesh;
   bank.params = params;
   const Camera tile = trainingCamera(mesh, params, views);
   // Views differing only by in-plane rotation share one rendering: the GPU renders each

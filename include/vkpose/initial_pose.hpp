@@ -1,0 +1,111 @@
+#pragma once
+// Initial pose (DESIGN.md stage 6; He, Rojas, Guan, section on the initial pose): the rotation
+// is the mean of the largest group of mutually close template rotations of a hypothesis, each
+// turned onto its own viewing ray; the translation moves the model, rendered at that rotation,
+// by the difference between the centroid of the scene points under its mask and the centroid
+// of its own rendered points. Rendering is the caller's (MeshRenderer): these functions are
+// plain data in, plain data out.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "vkpose/camera.hpp"
+#include "vkpose/hypotheses.hpp"
+#include "vkpose/point_cloud.hpp"
+#include "vkpose/render.hpp"
+#include "vkpose/template_bank.hpp"
+
+namespace vkpose {
+
+struct InitialPoseParams {
+  /// tau_theta: template rotations closer than this (axis-angle distance to a group's mean,
+  /// degrees) vote for the same rotation (the paper: 10 degrees).
+  float rotation_cluster_deg = 10.f;
+  /// A scene pixel under the rendered mask belongs to the object when its depth lies within
+  /// this fraction of the object's diameter of the rendered depth there. Nearer is an
+  /// occluder, farther is what lies behind the object (the mask is still misplaced by up to a
+  /// few centimetres at this stage).
+  float depth_band_fraction = 0.3f;
+  /// The scene crop that refinement and verification see: the rendered object's box grown by
+  /// this fraction of its size on every side, depths within the band of the rendered range.
+  float crop_margin_fraction = 0.25f;
+  /// Fewer scene points than this under the mask (a black hole in the depth map, an object
+  /// seen through a gap): the hypothesis is rejected.
+  std::size_t min_scene_points = 50;
+};
+
+/// Throws InputError naming the bad value.
+void validateInitialPoseParams(const InitialPoseParams& params);
+
+/// Axis-angle distance between two rotations, radians in [0, pi].
+float rotationDistance(const Eigen::Matrix3f& a, const Eigen::Matrix3f& b);
+
+/// The chordal L2 mean of rotations: the quaternions are sign-aligned with the first (q and -q
+/// are one rotation), summed with the weights (empty: equal) and normalized. Close to the
+/// geodesic mean for rotations a few degrees apart, which is all it is used for.
+Eigen::Matrix3f meanRotation(const std::vector<Eigen::Matrix3f>& rotations, const std::vector<float>& weights = {});
+
+struct RotationGroup {
+  Eigen::Matrix3f mean = Eigen::Matrix3f::Identity();
+  std::vector<int> members;  ///< indices into the rotations, in input order
+  float weight = 0.f;        ///< sum of the members' weights
+};
+
+/// Greedy clustering: in input order (callers pass the best templates first), a rotation joins
+/// the group whose current mean is nearest, if that is within max_angle_rad, and the group's
+/// mean is recomputed; otherwise it starts a group. Measuring against the mean, not the first
+/// member, keeps a group from drifting along a chain of near neighbours. Returns the groups
+/// largest first (ties: larger weight first).
+std::vector<RotationGroup> clusterRotations(const std::vector<Eigen::Matrix3f>& rotations, float max_angle_rad,
+                                            const std::vector<float>& weights = {});
+
+struct InitialRotation {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera
+  int group_size = 0;  ///< templates in the chosen group
+  int candidates = 0;  ///< templates of the hypothesis
+};
+
+/// Stage 6, rotation: every member's template rotation is turned onto the viewing ray through
+/// the object centre it was matched at (off the image centre the same view appears rotated:
+/// about 30 degrees at the corners of a 640x480 Kinect image); the rotations are clustered at
+/// tau_theta, best similarity first, and the largest group's mean is the initial rotation.
+InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
+                                const InitialPoseParams& params = {});
+
+/// A pose with rotation R whose object centre `centre` (object frame) lies on the viewing ray
+/// through pixel (x, y), `range` metres from the camera.
+Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const Eigen::Vector3f& centre,
+                 const Camera& camera);
+
+/// A pose with rotation R whose object centre (bank.centre) lies on the viewing ray through the
+/// hypothesis centre, at the distance of the hypothesis's best-fitting template plus that
+/// member's measured depth offset: where stage 6 renders the model.
+Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const TemplateBank& bank, const Camera& camera);
+
+struct InitialPose {
+  Pose pose;  ///< the rendered pose moved by the centroid difference
+  /// The model surface the camera sees at the rendered pose, object frame (metres): what ICP
+  /// aligns and what verification checks (not all mesh vertices: the hidden back side would
+  /// pull the fit towards the camera).
+  PointCloud model_points;
+  /// Camera-frame scene points around the object (see crop_margin_fraction).
+  PointCloud scene_points;
+  std::size_t mask_pixels = 0;   ///< rendered object pixels
+  std::size_t object_pixels = 0; ///< scene pixels under the mask that fell in the depth band
+  bool ok = false;               ///< false: too few object pixels; `why` says so
+  std::string why;
+};
+
+/// Stage 6, translation. `rendering` is the model rendered at `rendered` with the scene's
+/// camera and image size; `scene_depth_m` is the scene depth in metres (0 = none). The scene
+/// points under the mask that lie in the depth band and the rendered points at the same
+/// pixels and at the pixels where the scene is farther (the mask overhangs the object: that
+/// is the misplacement to correct) give the two centroids. Pixels where the scene is nearer
+/// (occluded) or has no depth are left out of both, so occlusion does not bias the shift.
+InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered, const cv::Mat& scene_depth_m,
+                               const Camera& camera, float diameter, const InitialPoseParams& params = {});
+
+}  // namespace vkpose

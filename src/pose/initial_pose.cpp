@@ -1,0 +1,188 @@
+// Stage 6: initial rotation from the templates of a hypothesis, initial translation from the
+// centroids of the scene and rendered points under the rendered mask.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "vkpose/error.hpp"
+#include "vkpose/initial_pose.hpp"
+
+namespace vkpose {
+
+void validateInitialPoseParams(const InitialPoseParams& p) {
+  if (!(p.rotation_cluster_deg > 0.f && p.rotation_cluster_deg <= 180.f))
+    throw InputError(fmt::format("the rotation cluster angle must be in (0, 180] degrees, not {}",
+                                 p.rotation_cluster_deg));
+  if (!(p.depth_band_fraction > 0.f && p.depth_band_fraction <= 10.f))
+    throw InputError(fmt::format("the depth band must be in (0, 10] diameters, not {}", p.depth_band_fraction));
+  if (!(p.crop_margin_fraction >= 0.f && p.crop_margin_fraction <= 10.f))
+    throw InputError(fmt::format("the crop margin must be in [0, 10] object sizes, not {}", p.crop_margin_fraction));
+}
+
+float rotationDistance(const Eigen::Matrix3f& a, const Eigen::Matrix3f& b) {
+  // trace(A^T B) = 1 + 2 cos(angle); clamped against rounding just outside [-1, 1].
+  const float c = std::clamp(0.5f * ((a.transpose() * b).trace() - 1.f), -1.f, 1.f);
+  return std::acos(c);
+}
+
+Eigen::Matrix3f meanRotation(const std::vector<Eigen::Matrix3f>& rotations, const std::vector<float>& weights) {
+  if (rotations.empty()) return Eigen::Matrix3f::Identity();
+  const Eigen::Quaternionf first(rotations.front());
+  Eigen::Vector4f sum = Eigen::Vector4f::Zero();
+  for (std::size_t i = 0; i < rotations.size(); ++i) {
+    Eigen::Quaternionf q(rotations[i]);
+    if (q.dot(first) < 0.f) q.coeffs() = -q.coeffs();
+    sum += (weights.empty() ? 1.f : weights[i]) * q.coeffs();
+  }
+  if (sum.norm() < 1e-12f) return rotations.front();
+  Eigen::Quaternionf mean;
+  mean.coeffs() = sum.normalized();
+  return mean.toRotationMatrix();
+}
+
+std::vector<RotationGroup> clusterRotations(const std::vector<Eigen::Matrix3f>& rotations, float max_angle_rad,
+                                            const std::vector<float>& weights) {
+  auto weightOf = [&](int i) { return weights.empty() ? 1.f : weights[static_cast<std::size_t>(i)]; };
+  std::vector<RotationGroup> groups;
+  for (int i = 0; i < static_cast<int>(rotations.size()); ++i) {
+    const Eigen::Matrix3f& R = rotations[static_cast<std::size_t>(i)];
+    RotationGroup* nearest = nullptr;
+    float nearest_angle = max_angle_rad;
+    for (auto& g : groups)
+      if (const float a = rotationDistance(g.mean, R); a < nearest_angle) nearest_angle = a, nearest = &g;
+    if (!nearest) {
+      groups.push_back({R, {i}, weightOf(i)});
+      continue;
+    }
+    nearest->members.push_back(i);
+    nearest->weight += weightOf(i);
+    std::vector<Eigen::Matrix3f> rs;
+    std::vector<float> ws;
+    for (int m : nearest->members) {
+      rs.push_back(rotations[static_cast<std::size_t>(m)]);
+      ws.push_back(weightOf(m));
+    }
+    nearest->mean = meanRotation(rs, ws);
+  }
+  std::stable_sort(groups.begin(), groups.end(), [](const RotationGroup& a, const RotationGroup& b) {
+    return a.members.size() != b.members.size() ? a.members.size() > b.members.size() : a.weight > b.weight;
+  });
+  return groups;
+}
+
+InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
+                                const InitialPoseParams& params) {
+  std::vector<Eigen::Matrix3f> rotations;
+  std::vector<float> weights;
+  for (const ClusterMember& m : h.members) {  // best similarity first
+    const BankTemplate& t = bank.templates.at(static_cast<std::size_t>(m.template_index));
+    rotations.push_back(viewingRayRotation(m.centre_x, m.centre_y, camera) * t.pose.R);
+    weights.push_back(m.similarity);
+  }
+  InitialRotation out;
+  out.candidates = static_cast<int>(rotations.size());
+  if (rotations.empty()) return out;
+  const auto groups = clusterRotations(rotations, params.rotation_cluster_deg * static_cast<float>(M_PI) / 180.f,
+                                       weights);
+  out.R = groups.front().mean;
+  out.group_size = static_cast<int>(groups.front().members.size());
+  return out;
+}
+
+Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const TemplateBank& bank, const Camera& camera) {
+  // The training camera looked at bank.centre, so the centre's range is the template's; the
+  // cluster score measured how far the scene surface is from the template's (depth_offset).
+  float range = h.distance;
+  if (h.best_member >= 0 && static_cast<std::size_t>(h.best_member) < h.members.size()) {
+    const auto best = static_cast<std::size_t>(h.best_member);
+    const BankTemplate& t = bank.templates.at(static_cast<std::size_t>(h.members[best].template_index));
+    range = (t.pose.R * bank.centre + t.pose.t).norm();
+    if (best < h.member_scores.size()) range += h.member_scores[best].depth_offset;
+  }
+  return poseAtRange(R, h.x, h.y, range, bank.centre, camera);
+}
+
+Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const Eigen::Vector3f& centre,
+                 const Camera& camera) {
+  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
+                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  Pose p;
+  p.R = R;
+  p.t = ray.normalized() * range - R * centre;
+  return p;
+}
+
+InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered, const cv::Mat& scene_depth_m,
+                               const Camera& camera, float diameter, const InitialPoseParams& params) {
+  if (rendering.depth.size() != scene_depth_m.size() || rendering.depth.type() != CV_32FC1 ||
+      scene_depth_m.type() != CV_32FC1)
+    throw InputError(fmt::format("initial translation: a {}x{} rendering for a {}x{} scene depth (both CV_32FC1)",
+                                 rendering.depth.cols, rendering.depth.rows, scene_depth_m.cols, scene_depth_m.rows));
+  const float band = params.depth_band_fraction * diameter;
+  auto backProject = [&](int u, int v, float z) {
+    return Eigen::Vector3f(static_cast<float>((u - camera.cx) / camera.fx) * z,
+                           static_cast<float>((v - camera.cy) / camera.fy) * z, z);
+  };
+  InitialPose out;
+  out.pose = rendered;
+  Eigen::Vector3d scene_sum = Eigen::Vector3d::Zero(), model_sum = Eigen::Vector3d::Zero();
+  std::size_t model_count = 0;
+  cv::Rect box;  // the rendered object's pixels
+  float z_min = std::numeric_limits<float>::max(), z_max = 0.f;
+  const Eigen::Matrix3f R_inv = rendered.R.transpose();
+  for (int v = 0; v < rendering.depth.rows; ++v) {
+    const float* zr = rendering.depth.ptr<float>(v);
+    const float* zs = scene_depth_m.ptr<float>(v);
+    for (int u = 0; u < rendering.depth.cols; ++u) {
+      if (!(zr[u] > 0.f)) continue;
+      ++out.mask_pixels;
+      box |= cv::Rect(u, v, 1, 1);
+      z_min = std::min(z_min, zr[u]);
+      z_max = std::max(z_max, zr[u]);
+      const Eigen::Vector3f pm = backProject(u, v, zr[u]);
+      out.model_points.push_back(R_inv * (pm - rendered.t));
+      if (!(zs[u] > 0.f) || zs[u] < zr[u] - band) continue;  // no depth, or an occluder
+      model_sum += pm.cast<double>();
+      ++model_count;
+      if (zs[u] > zr[u] + band) continue;  // background seen past the object's edge
+      scene_sum += backProject(u, v, zs[u]).cast<double>();
+      ++out.object_pixels;
+    }
+  }
+  if (out.mask_pixels == 0) {
+    out.why = "the model renders outside the image";
+    return out;
+  }
+  if (out.object_pixels < params.min_scene_points) {
+    out.why = fmt::format("{} scene points under the {}-pixel model (at least {} needed): no depth there",
+                          out.object_pixels, out.mask_pixels, params.min_scene_points);
+    return out;
+  }
+  const Eigen::Vector3d shift = scene_sum / static_cast<double>(out.object_pixels) -
+                                model_sum / static_cast<double>(model_count);
+  out.pose.t = rendered.t + shift.cast<float>();
+
+  // The crop around the moved model: its box (moved by the shift's projection) grown by the
+  // margin, depths within the band of its moved depth range.
+  const Eigen::Vector3f centre_before = rendered.t, centre_after = out.pose.t;
+  const Eigen::Vector2f image_shift = camera.project(centre_after) - camera.project(centre_before);
+  const int mx = static_cast<int>(std::ceil(params.crop_margin_fraction * static_cast<float>(box.width)));
+  const int my = static_cast<int>(std::ceil(params.crop_margin_fraction * static_cast<float>(box.height)));
+  cv::Rect crop(box.x + static_cast<int>(std::lround(image_shift.x())) - mx,
+                box.y + static_cast<int>(std::lround(image_shift.y())) - my, box.width + 2 * mx, box.height + 2 * my);
+  crop &= cv::Rect(0, 0, scene_depth_m.cols, scene_depth_m.rows);
+  const float near = z_min + static_cast<float>(shift.z()) - band, far = z_max + static_cast<float>(shift.z()) + band;
+  for (int v = crop.y; v < crop.y + crop.height; ++v) {
+    const float* zs = scene_depth_m.ptr<float>(v);
+    for (int u = crop.x; u < crop.x + crop.width; ++u)
+      if (zs[u] > near && zs[u] < far) out.scene_points.push_back(backProject(u, v, zs[u]));
+  }
+  out.ok = true;
+  return out;
+}
+
+}  // namespace vkpose
