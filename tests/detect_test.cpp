@@ -19,26 +19,10 @@ namespace {
 /// cached in the build folder between runs: training takes most of a minute on 2 cores.
 const TemplateBank& icbinCupBank() {
   static const TemplateBank bank = [] {
-    const std::string cache = std::string(VKPOSE_TEST_CACHE_DIR) + "/coffee_cup_icbin.vkpb";
-    const Mesh mesh = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl");
     TrainingParams params;
     params.camera = loadCamera(test::sharedData() + "/icbin/camera.json");
     params.symmetric = true;
-    if (std::filesystem::exists(cache)) {
-      try {
-        TemplateBank cached = loadBank(cache);
-        if (cached.mesh_hash == mesh.file_hash && cached.templates.size() == 14040) return cached;
-      } catch (const InputError&) {
-        // A stale or damaged cache: train again.
-      }
-    }
-    TemplateBank b = trainTemplates(test::context(), mesh, params);
-    // Written aside and renamed: tests in other processes may read the cache meanwhile.
-    std::filesystem::create_directories(VKPOSE_TEST_CACHE_DIR);
-    const std::string partial = cache + "." + std::to_string(::getpid()) + ".part";
-    saveBank(b, partial);
-    std::filesystem::rename(partial, cache);
-    return b;
+    return test::cachedBank("coffee_cup_icbin", loadMesh(test::sharedData() + "/meshes/coffee_cup.stl"), params);
   }();
   return bank;
 }

@@ -10,6 +10,7 @@
 
 #include "vkpose/features.hpp"
 #include "vkpose/gpu_context.hpp"
+#include "vkpose/template_bank.hpp"
 #include "vkpose/templates.hpp"
 
 namespace vkpose::test {
@@ -28,6 +29,11 @@ std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const Feat
 
 /// The message of the InputError `f` throws; fails the test when it throws nothing.
 std::string inputErrorOf(const std::function<void()>& f);
+
+/// A bank trained from `mesh` with `params`, cached as VKPOSE_TEST_CACHE_DIR/`name`.vkpb
+/// between runs (training takes about a minute per object on 2 cores). A cache from another
+/// mesh, with another template count or another bank version is trained again.
+TemplateBank cachedBank(const std::string& name, const Mesh& mesh, const TrainingParams& params);
 
 /// One Vulkan context shared by all tests of a process (lavapipe in CI).
 GpuContext& context();
