@@ -65,7 +65,8 @@ struct PlacementParams {
   float image_margin = 0.1f;     ///< table: objects stand this share of the image inside its border
   int tries = 200;               ///< positions tried per object before leaving it out
   float drop_step_m = 0.002f;    ///< bin: height step of the drop-and-settle search
-  float max_pile_m = 0.35f;      ///< bin: an object settling higher than this is left out
+  float bin_max_tilt_deg = 35.f; ///< bin: resting orientations tipped by up to this much
+  float max_pile_m = 0.2f;       ///< bin: an object whose bottom settles higher than this is left out
 };
 
 /// Where the camera may be: height of its centre above the table and tilt of its optical axis
@@ -90,8 +91,8 @@ std::vector<OrientedBox> binWalls(const PlacementParams& params);
 
 /// Places the meshes in order, each clear of `obstacles` and of those placed before it:
 /// table: a stable resting orientation with a random yaw at a point of the table the camera
-/// sees (camera_T_world, camera) away from the image border; bin: a random orientation at a
-/// random point over the bin, lowered to the lowest free height. Returns world_T_object per
+/// sees (camera_T_world, camera) away from the image border; bin: a resting orientation with
+/// a random yaw and tip at a random point over the bin, lowered to the lowest free height. Returns world_T_object per
 /// mesh; nothing for a mesh that found no free place in params.tries.
 std::vector<std::optional<Pose>> placeObjects(const std::vector<const Mesh*>& meshes,
                                               std::vector<OrientedBox> obstacles, const PlacementParams& params,

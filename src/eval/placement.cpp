@@ -22,15 +22,6 @@ float radians(float degrees) { return degrees * kPi / 180.f; }
 
 Eigen::Matrix3f yaw(float angle) { return Eigen::AngleAxisf(angle, Eigen::Vector3f::UnitZ()).toRotationMatrix(); }
 
-/// A rotation uniform over SO(3) (Shoemake's unit quaternion from three uniforms).
-Eigen::Matrix3f randomRotation(std::mt19937& rng) {
-  const float u1 = uniform(rng, 0.f, 1.f), u2 = uniform(rng, 0.f, 2.f * kPi), u3 = uniform(rng, 0.f, 2.f * kPi);
-  const float a = std::sqrt(1.f - u1), b = std::sqrt(u1);
-  return Eigen::Quaternionf(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3))
-      .normalized()
-      .toRotationMatrix();
-}
-
 /// Lowest z of the mesh's vertices turned by R.
 float lowestZ(const Mesh& mesh, const Eigen::Matrix3f& R) {
   const Eigen::RowVector3f row = R.row(2);
@@ -79,10 +70,17 @@ std::optional<Pose> tryOnTable(const Mesh& mesh, const std::vector<RestingOrient
 
 /// Bin: a random orientation over a random point of the bin, lowered onto the floor or the
 /// objects below, whichever it meets first (the lowest height at which its box is clear).
-std::optional<Pose> tryInBin(const Mesh& mesh, const std::vector<OrientedBox>& placed, const PlacementParams& params,
-                             std::mt19937& rng) {
+std::optional<Pose> tryInBin(const Mesh& mesh, const std::vector<RestingOrientation>& rest,
+                             const std::vector<OrientedBox>& placed, const PlacementParams& params, std::mt19937& rng) {
+  // A resting orientation with a random yaw, tipped by up to max_tilt_deg about a random
+  // horizontal axis: parts in a bin lie on a side, leaning on each other. Fully random
+  // rotations would stack their (then loose) boxes into towers.
+  const RestingOrientation& r = pickResting(rest, rng);
+  const float turn = uniform(rng, 0.f, 2.f * kPi), tip_axis = uniform(rng, 0.f, 2.f * kPi);
+  const float tip = radians(uniform(rng, 0.f, params.bin_max_tilt_deg));
   Pose p;
-  p.R = randomRotation(rng);
+  p.R = Eigen::AngleAxisf(tip, Eigen::Vector3f(std::cos(tip_axis), std::sin(tip_axis), 0.f)).toRotationMatrix() *
+        yaw(turn) * r.R;
   const OrientedBox at_origin = orientedBox(mesh, p);
   const Eigen::Vector3f ext = worldHalfExtent(at_origin);
   const Eigen::Vector2f room = 0.5f * params.bin_inner_m - ext.head<2>() - Eigen::Vector2f::Constant(params.gap_m);
@@ -236,13 +234,12 @@ std::vector<std::optional<Pose>> placeObjects(const std::vector<const Mesh*>& me
   std::vector<std::optional<Pose>> out;
   for (const Mesh* mesh : meshes) {
     if (!mesh) throw InputError("placeObjects: a mesh is missing");
-    std::vector<RestingOrientation> rest;
-    if (params.layout == Layout::Table) rest = restingOrientations(*mesh);
+    const std::vector<RestingOrientation> rest = restingOrientations(*mesh);
     std::optional<Pose> found;
     for (int t = 0; t < params.tries && !found; ++t) {
       std::optional<Pose> p = params.layout == Layout::Table
                                   ? tryOnTable(*mesh, rest, camera, world_T_camera, params, rng)
-                                  : tryInBin(*mesh, obstacles, params, rng);
+                                  : tryInBin(*mesh, rest, obstacles, params, rng);
       if (p && clear(orientedBox(*mesh, *p), obstacles, params.gap_m)) found = p;
     }
     if (found) obstacles.push_back(orientedBox(*mesh, *found));

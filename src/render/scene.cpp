@@ -25,11 +25,16 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
   out.full_masks.assign(objects.size(), cv::Mat());
   if (objects.size() > 65535) throw InputError("a scene holds at most 65535 objects");
 
-  // One renderer per distinct mesh, all of its poses in one call.
-  std::map<const Mesh*, std::vector<std::size_t>> by_mesh;
+  // One renderer per distinct mesh, all of its poses in one call. Meshes go in the order they
+  // first appear, not by address: where two surfaces are at the same depth the earlier object
+  // wins, the same in every run.
+  std::vector<std::pair<const Mesh*, std::vector<std::size_t>>> by_mesh;
+  std::map<const Mesh*, std::size_t> group;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     if (!objects[i].mesh) throw InputError("scene object " + std::to_string(i) + " has no mesh");
-    by_mesh[objects[i].mesh].push_back(i);
+    const auto [it, added] = group.emplace(objects[i].mesh, by_mesh.size());
+    if (added) by_mesh.push_back({objects[i].mesh, {}});
+    by_mesh[it->second].second.push_back(i);
   }
   for (const auto& [mesh, indices] : by_mesh) {
     MeshRenderer renderer(ctx, *mesh);
