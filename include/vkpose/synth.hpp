@@ -38,6 +38,11 @@ struct SynthParams {
   CameraRange camera_range;                 ///< random: where the camera may be
 };
 
+/// InputError for parameters no dataset can come from (no mesh, images < 1, instances or
+/// clutter out of range, a --symmetric obj_id without a mesh, poses neither "random" nor a
+/// folder, the bin layout with pose files, a bad camera). Files are checked when read.
+void validateSynthParams(const SynthParams& params);
+
 /// The pose files for each mesh, sorted by their number N (posesN.txt): `dir` itself when it
 /// holds pose files (one mesh only), otherwise the subfolder of `dir` named like each mesh's
 /// stem, ignoring case, '_' and '-' (juicecarton.stl takes juice_carton/). InputError naming

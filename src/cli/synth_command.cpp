@@ -77,6 +77,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     params.placement.layout = opt->layout == "bin" ? Layout::Bin : Layout::Table;
     std::tie(params.min_instances, params.max_instances) = parseRange(opt->instances);
     if (!opt->camera.empty()) params.camera = loadCamera(opt->camera);
+    validateSynthParams(params);  // bad input is exit 1 even on a machine without a device
     GpuContext ctx(global.gpu());
     ProgressBar bar("rendering", global.quiet);
     const SynthSummary s = generateSyntheticDataset(ctx, params, opt->out, opt->force,

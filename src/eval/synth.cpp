@@ -36,26 +36,6 @@ Eigen::Vector3f randomColour(std::mt19937& rng, float lo, float hi) {
   return {uniform(rng, lo, hi), uniform(rng, lo, hi), uniform(rng, lo, hi)};
 }
 
-void validate(const SynthParams& p) {
-  if (p.meshes.empty()) throw InputError("synth needs at least one mesh");
-  if (p.images < 1) throw InputError(fmt::format("--images must be 1 or more, not {}", p.images));
-  if (p.min_instances < 0 || p.max_instances < p.min_instances || p.max_instances > 50)
-    throw InputError(fmt::format("instances per mesh {}..{}: need 0 <= min <= max <= 50", p.min_instances,
-                                 p.max_instances));
-  if (p.clutter < 0 || p.clutter > 50) throw InputError(fmt::format("clutter {} is outside 0..50", p.clutter));
-  for (const int id : p.symmetric)
-    if (id < 1 || id > static_cast<int>(p.meshes.size()))
-      throw InputError(fmt::format("--symmetric {}: obj_ids are 1..{} (the meshes in order)", id, p.meshes.size()));
-  if (p.poses != "random") {
-    std::error_code ec;
-    if (!fs::is_directory(p.poses, ec))
-      throw InputError(fmt::format("--poses {}: neither 'random' nor a folder of pose files", p.poses));
-    if (p.placement.layout == Layout::Bin)
-      throw InputError("the bin layout places objects itself: use it with --poses random");
-  }
-  validateCamera(p.camera, "synth camera");
-}
-
 /// "Juice_Carton" and "juicecarton" name the same object.
 std::string normalisedName(const std::string& s) {
   std::string out;
@@ -284,6 +264,26 @@ DepthNoiseParams synthNoise() {
   return n;
 }
 
+void validateSynthParams(const SynthParams& p) {
+  if (p.meshes.empty()) throw InputError("synth needs at least one mesh");
+  if (p.images < 1) throw InputError(fmt::format("--images must be 1 or more, not {}", p.images));
+  if (p.min_instances < 0 || p.max_instances < p.min_instances || p.max_instances > 50)
+    throw InputError(fmt::format("instances per mesh {}..{}: need 0 <= min <= max <= 50", p.min_instances,
+                                 p.max_instances));
+  if (p.clutter < 0 || p.clutter > 50) throw InputError(fmt::format("clutter {} is outside 0..50", p.clutter));
+  for (const int id : p.symmetric)
+    if (id < 1 || id > static_cast<int>(p.meshes.size()))
+      throw InputError(fmt::format("--symmetric {}: obj_ids are 1..{} (the meshes in order)", id, p.meshes.size()));
+  if (p.poses != "random") {
+    std::error_code ec;
+    if (!fs::is_directory(p.poses, ec))
+      throw InputError(fmt::format("--poses {}: neither 'random' nor a folder of pose files", p.poses));
+    if (p.placement.layout == Layout::Bin)
+      throw InputError("the bin layout places objects itself: use it with --poses random");
+  }
+  validateCamera(p.camera, "synth camera");
+}
+
 std::vector<std::vector<std::string>> tejaniPoseFiles(const std::string& dir,
                                                       const std::vector<std::string>& mesh_names) {
   const fs::path root(dir);
@@ -319,7 +319,7 @@ std::vector<std::vector<std::string>> tejaniPoseFiles(const std::string& dir,
 
 SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& p, const std::string& out_dir,
                                       bool overwrite, const std::function<void(int, int)>& progress) {
-  validate(p);
+  validateSynthParams(p);
   SynthSummary summary;
   std::vector<Mesh> models;
   for (std::size_t i = 0; i < p.meshes.size(); ++i) {
