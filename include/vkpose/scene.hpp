@@ -16,11 +16,15 @@ struct SceneObject {
 };
 
 struct SceneRendering {
+  Camera camera;     ///< the camera it was rendered with
   cv::Mat depth;     ///< CV_32FC1 metres, 0 where nothing is
+  cv::Mat normals;   ///< CV_32FC3 unit normals in the camera frame, facing the camera; 0 where nothing is
   cv::Mat bgr;       ///< CV_8UC3
   cv::Mat instance;  ///< CV_16UC1: 1 + index of the object seen at each pixel, 0 for none
   /// Pixels of each object that are visible, and that it would cover alone.
   std::vector<int> visible_pixels, full_pixels;
+  /// CV_8UC1 silhouette of each object alone (255 inside): what it would cover unoccluded.
+  std::vector<cv::Mat> full_masks;
   float visibleFraction(std::size_t i) const {
     return full_pixels[i] > 0 ? static_cast<float>(visible_pixels[i]) / static_cast<float>(full_pixels[i]) : 0.f;
   }
@@ -33,18 +37,50 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
 /// `grey` 0..1: a table under or behind the objects.
 Mesh planeMesh(float size, float grey = 0.55f);
 
+/// A box of side lengths `size` (metres) centred at the origin, flat-shaded (its own vertices
+/// per face), of one colour (RGB 0..1): clutter, bin walls.
+Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb);
+
+/// A closed cylinder along z centred at the origin, `segments` sides: cans and jars as clutter.
+Mesh cylinderMesh(float radius, float height, const Eigen::Vector3f& rgb, int segments = 32);
+
+/// Light on a scene whose colours are albedos (meshes with vertex colours render unshaded):
+/// a directional light with ambient and a specular highlight, and a per-channel gain for
+/// exposure and white balance, so that the same object looks different from frame to frame.
+struct Lighting {
+  Eigen::Vector3f direction = {0.f, 0.f, 1.f};  ///< camera frame, from the light into the scene
+  float ambient = 0.35f;                        ///< share of the albedo lit from everywhere
+  float diffuse = 0.65f;                        ///< Lambert term's weight
+  float specular = 0.f;                         ///< Phong highlight's weight, grey levels / 255
+  float shininess = 20.f;                       ///< Phong exponent
+  Eigen::Vector3f gain = Eigen::Vector3f::Ones();  ///< per channel (B, G, R)
+};
+
+/// Replaces scene.bgr (albedo) by albedo * gain * (ambient + diffuse * n.l) + highlight, using
+/// scene.normals; pixels where nothing is stay as they are.
+void applyLighting(SceneRendering& scene, const Lighting& light);
+
 /// Structured-light depth noise: axial Gaussian noise growing with distance squared,
-/// quantization, and dropouts at depth edges.
+/// quantization, dropouts at depth edges and at grazing angles, and random holes (dark or
+/// shiny patches the projector's pattern does not come back from). Grazing dropouts and holes
+/// are off by default, which keeps the frames of callers that predate them as they were.
 struct DepthNoiseParams {
   float axial_sigma_at_1m = 0.0015f;  ///< metres at 1 m; sigma(z) = this * z^2 (Kinect-like)
   float quantization_m = 0.001f;      ///< the sensor's depth step (16-bit PNG in mm)
   float edge_jump_m = 0.02f;          ///< a neighbour this much nearer or farther marks an edge
   float edge_dropout = 0.5f;          ///< chance that an edge pixel reads nothing
   float colour_sigma = 3.f;           ///< Gaussian noise on each colour channel, grey levels
+  /// Surfaces seen more obliquely than this (angle between normal and viewing ray) start to
+  /// lose readings; the chance grows linearly to grazing_dropout at 90 degrees.
+  float grazing_start_deg = 70.f;
+  float grazing_dropout = 0.f;        ///< chance of no reading at 90 degrees (0: off)
+  int holes = 0;                      ///< random elliptic holes per frame (0: off)
+  float hole_radius_px[2] = {3.f, 12.f};  ///< smallest and largest hole semi-axis, pixels
+  float max_range_m = 0.f;            ///< readings farther than this are lost (0: no limit)
 };
 
 /// The frame a sensor would deliver (depth in millimetres, 0 = no reading); reproducible
-/// from `seed`.
+/// from `seed`. Grazing dropouts use scene.normals and scene.camera.
 LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& noise, uint32_t seed);
 
 }  // namespace vkpose

@@ -30,6 +30,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDemoCommand(CLI::App& app, const GlobalOptions& global);
 Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global);
+Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   add(addInfoCommand);
   add(addTrainCommand);
   add(addDetectCommand);
+  add(addSynthCommand);
   add(addBenchCommand);
   add(addDemoCommand);
 

@@ -1,7 +1,10 @@
 // Synthetic multi-object scenes and sensor noise.
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
+
+#include <opencv2/imgproc.hpp>
 
 #include "vkpose/error.hpp"
 #include "vkpose/scene.hpp"
@@ -12,18 +15,26 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
   validateCamera(camera);
   const cv::Size size(camera.width, camera.height);
   SceneRendering out;
+  out.camera = camera;
   out.depth = cv::Mat::zeros(size, CV_32FC1);
+  out.normals = cv::Mat::zeros(size, CV_32FC3);
   out.bgr = cv::Mat::zeros(size, CV_8UC3);
   out.instance = cv::Mat::zeros(size, CV_16UC1);
   out.visible_pixels.assign(objects.size(), 0);
   out.full_pixels.assign(objects.size(), 0);
+  out.full_masks.assign(objects.size(), cv::Mat());
   if (objects.size() > 65535) throw InputError("a scene holds at most 65535 objects");
 
-  // One renderer per distinct mesh, all of its poses in one call.
-  std::map<const Mesh*, std::vector<std::size_t>> by_mesh;
+  // One renderer per distinct mesh, all of its poses in one call. Meshes go in the order they
+  // first appear, not by address: where two surfaces are at the same depth the earlier object
+  // wins, the same in every run.
+  std::vector<std::pair<const Mesh*, std::vector<std::size_t>>> by_mesh;
+  std::map<const Mesh*, std::size_t> group;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     if (!objects[i].mesh) throw InputError("scene object " + std::to_string(i) + " has no mesh");
-    by_mesh[objects[i].mesh].push_back(i);
+    const auto [it, added] = group.emplace(objects[i].mesh, by_mesh.size());
+    if (added) by_mesh.push_back({objects[i].mesh, {}});
+    by_mesh[it->second].second.push_back(i);
   }
   for (const auto& [mesh, indices] : by_mesh) {
     MeshRenderer renderer(ctx, *mesh);
@@ -33,7 +44,8 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
     for (std::size_t k = 0; k < indices.size(); ++k) {
       const Rendering& r = views[k];
       const auto label = static_cast<uint16_t>(indices[k] + 1);
-      out.full_pixels[indices[k]] = cv::countNonZero(r.depth > 0.f);
+      out.full_masks[indices[k]] = r.mask();
+      out.full_pixels[indices[k]] = cv::countNonZero(out.full_masks[indices[k]]);
       for (int y = 0; y < size.height; ++y)
         for (int x = 0; x < size.width; ++x) {
           const float z = r.depth.at<float>(y, x);
@@ -41,6 +53,7 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
           if (z > 0.f && (best == 0.f || z < best)) {
             best = z;
             out.bgr.at<cv::Vec3b>(y, x) = r.bgr.at<cv::Vec3b>(y, x);
+            out.normals.at<cv::Vec3f>(y, x) = r.normals.at<cv::Vec3f>(y, x);
             out.instance.at<uint16_t>(y, x) = label;
           }
         }
@@ -74,6 +87,131 @@ Mesh planeMesh(float size, float grey) {
   return m;
 }
 
+Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb) {
+  if (!(size.minCoeff() > 0.f) || size.maxCoeff() > 10.f) throw InputError("cuboid sides must be in (0, 10] metres");
+  Mesh m;
+  m.name = "cuboid";
+  const Eigen::Vector3f h = 0.5f * size;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const float sign : {-1.f, 1.f}) {
+      // The face at sign * h[axis]; u, v span it so that (u x v) points outwards.
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      Eigen::Vector3f n = Eigen::Vector3f::Zero(), u = Eigen::Vector3f::Zero(), v = Eigen::Vector3f::Zero();
+      n[axis] = sign;
+      u[a] = h[a];
+      v[b] = sign * h[b];
+      const int base = static_cast<int>(m.vertices.size());
+      for (const auto& [su, sv] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}}) {
+        m.vertices.push_back(n.cwiseProduct(h) + su * u + sv * v);
+        m.normals.push_back(n);
+      }
+      m.faces.emplace_back(base, base + 1, base + 2);
+      m.faces.emplace_back(base, base + 2, base + 3);
+    }
+  m.colours.assign(m.vertices.size(), rgb);
+  finishMesh(m);
+  return m;
+}
+
+Mesh cylinderMesh(float radius, float height, const Eigen::Vector3f& rgb, int segments) {
+  if (!(radius > 0.f && height > 0.f) || radius > 10.f || height > 10.f || segments < 3)
+    throw InputError("a cylinder needs a radius and height in (0, 10] metres and 3 or more segments");
+  Mesh m;
+  m.name = "cylinder";
+  const float h = 0.5f * height;
+  const auto ring = [&](int i) {
+    const float a = 2.f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(segments);
+    return Eigen::Vector2f(std::cos(a), std::sin(a));
+  };
+  for (int i = 0; i < segments; ++i) {  // side: two vertices per segment with radial normals
+    const Eigen::Vector2f c = ring(i);
+    for (const float z : {-h, h}) {
+      m.vertices.emplace_back(radius * c.x(), radius * c.y(), z);
+      m.normals.emplace_back(c.x(), c.y(), 0.f);
+    }
+  }
+  for (int i = 0; i < segments; ++i) {
+    const int a = 2 * i, b = 2 * ((i + 1) % segments);
+    m.faces.emplace_back(a, b, b + 1);
+    m.faces.emplace_back(a, b + 1, a + 1);
+  }
+  for (const float sign : {-1.f, 1.f}) {  // caps: a centre and a ring with axial normals
+    const int centre = static_cast<int>(m.vertices.size());
+    m.vertices.emplace_back(0.f, 0.f, sign * h);
+    m.normals.emplace_back(0.f, 0.f, sign);
+    for (int i = 0; i < segments; ++i) {
+      const Eigen::Vector2f c = ring(i);
+      m.vertices.emplace_back(radius * c.x(), radius * c.y(), sign * h);
+      m.normals.emplace_back(0.f, 0.f, sign);
+    }
+    for (int i = 0; i < segments; ++i) {
+      const int a = centre + 1 + i, b = centre + 1 + (i + 1) % segments;
+      if (sign > 0.f) m.faces.emplace_back(centre, a, b);
+      else m.faces.emplace_back(centre, b, a);
+    }
+  }
+  m.colours.assign(m.vertices.size(), rgb);
+  finishMesh(m);
+  return m;
+}
+
+void applyLighting(SceneRendering& scene, const Lighting& light) {
+  if (scene.normals.size() != scene.bgr.size()) throw InputError("applyLighting: the scene has no normals");
+  const Eigen::Vector3f to_light = -light.direction.normalized();
+  const Camera& cam = scene.camera;
+  for (int y = 0; y < scene.bgr.rows; ++y)
+    for (int x = 0; x < scene.bgr.cols; ++x) {
+      if (scene.depth.at<float>(y, x) <= 0.f) continue;
+      const cv::Vec3f& nv = scene.normals.at<cv::Vec3f>(y, x);
+      const Eigen::Vector3f n(nv[0], nv[1], nv[2]);
+      const float lambert = std::max(0.f, n.dot(to_light));
+      // Phong: the light mirrored about the normal against the direction to the camera.
+      const Eigen::Vector3f to_eye =
+          -Eigen::Vector3f(static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f)
+               .normalized();
+      const Eigen::Vector3f mirrored = 2.f * n.dot(to_light) * n - to_light;
+      const float highlight =
+          lambert > 0.f ? light.specular * 255.f * std::pow(std::max(0.f, mirrored.dot(to_eye)), light.shininess) : 0.f;
+      cv::Vec3b& c = scene.bgr.at<cv::Vec3b>(y, x);
+      for (int k = 0; k < 3; ++k)
+        c[k] = cv::saturate_cast<uint8_t>(c[k] * light.gain[k] * (light.ambient + light.diffuse * lambert) + highlight);
+    }
+}
+
+namespace {
+/// Drops the readings that grazing angles and random holes lose. Its own random stream
+/// (seeded from the frame's), so that turning these on leaves the other noise as it was.
+void dropGrazingAndHoles(const SceneRendering& scene, const DepthNoiseParams& noise, uint32_t seed, cv::Mat& depth_mm) {
+  if (noise.grazing_dropout <= 0.f && noise.holes <= 0) return;
+  std::mt19937 rng(seed ^ 0x9e3779b9u);
+  std::uniform_real_distribution<float> uniform(0.f, 1.f);
+  const Camera& cam = scene.camera;
+  if (noise.grazing_dropout > 0.f && scene.normals.size() == depth_mm.size()) {
+    const float start = std::cos(noise.grazing_start_deg * std::numbers::pi_v<float> / 180.f);
+    for (int y = 0; y < depth_mm.rows; ++y)
+      for (int x = 0; x < depth_mm.cols; ++x) {
+        if (scene.depth.at<float>(y, x) <= 0.f) continue;
+        const cv::Vec3f& n = scene.normals.at<cv::Vec3f>(y, x);
+        const Eigen::Vector3f ray =
+            Eigen::Vector3f(static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f)
+                .normalized();
+        const float cos_angle = std::abs(n[0] * ray.x() + n[1] * ray.y() + n[2] * ray.z());
+        const float u = uniform(rng);  // drawn for every surface pixel: reproducible layout
+        if (cos_angle < start && u < noise.grazing_dropout * (start - cos_angle) / start)
+          depth_mm.at<uint16_t>(y, x) = 0;
+      }
+  }
+  const float r0 = noise.hole_radius_px[0], r1 = std::max(r0, noise.hole_radius_px[1]);
+  for (int h = 0; h < noise.holes; ++h) {
+    const cv::Point centre(static_cast<int>(uniform(rng) * static_cast<float>(depth_mm.cols)),
+                           static_cast<int>(uniform(rng) * static_cast<float>(depth_mm.rows)));
+    const cv::Size axes(static_cast<int>(std::lround(r0 + (r1 - r0) * uniform(rng))),
+                        static_cast<int>(std::lround(r0 + (r1 - r0) * uniform(rng))));
+    cv::ellipse(depth_mm, centre, axes, 180.0 * uniform(rng), 0, 360, cv::Scalar(0), cv::FILLED);
+  }
+}
+}  // namespace
+
 LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& noise, uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<float> gauss(0.f, 1.f);
@@ -84,7 +222,7 @@ LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& no
   for (int y = 0; y < z.rows; ++y)
     for (int x = 0; x < z.cols; ++x) {
       const float d = z.at<float>(y, x);
-      if (d <= 0.f) continue;
+      if (d <= 0.f || (noise.max_range_m > 0.f && d > noise.max_range_m)) continue;
       bool edge = false;
       for (int dy = -1; dy <= 1 && !edge; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -103,6 +241,7 @@ LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& no
       if (noise.quantization_m > 0.f) noisy = std::round(noisy / noise.quantization_m) * noise.quantization_m;
       f.depth_mm.at<uint16_t>(y, x) = static_cast<uint16_t>(std::clamp(std::lround(noisy * 1000.f), 0l, 65535l));
     }
+  dropGrazingAndHoles(scene, noise, seed, f.depth_mm);
   f.bgr = cv::Mat(scene.bgr.size(), CV_8UC3);
   for (int y = 0; y < f.bgr.rows; ++y)
     for (int x = 0; x < f.bgr.cols; ++x)

@@ -1,0 +1,104 @@
+// `vkpose synth --mesh MESH ... --poses DIR|random --images N --seed S --out DIR`: a synthetic
+// multi-instance BOP dataset (include/vkpose/synth.hpp does the work).
+#include <charconv>
+
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/synth.hpp"
+
+namespace vkpose::cli {
+
+namespace {
+struct SynthOptions {
+  std::string units = "auto", layout = "table", instances = "1:3", camera, out;
+  bool force = false;
+  SynthParams params;
+};
+
+int toInt(const std::string& text, const char* flag) {
+  int v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size())
+    throw InputError(fmt::format("{} '{}': expected a whole number", flag, text));
+  return v;
+}
+
+/// "N" or "MIN:MAX".
+std::pair<int, int> parseRange(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) {
+    const int n = toInt(text, "--instances");
+    return {n, n};
+  }
+  return {toInt(text.substr(0, colon), "--instances"), toInt(text.substr(colon + 1), "--instances")};
+}
+
+const char* unitName(MeshUnits u) { return u == MeshUnits::Millimetres ? "mm" : "m"; }
+}  // namespace
+
+Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<SynthOptions>();
+  auto& p = opt->params;
+  auto* sub = app.add_subcommand("synth", "Render a synthetic multi-instance RGB-D dataset in BOP format");
+  sub->add_option("--mesh", p.meshes, "Object mesh (STL, PLY, OBJ); repeat for several objects, obj_id 1, 2, ...")
+      ->required();
+  sub->add_option("--units", opt->units, "Mesh units: mm, m, or auto (from the object's size)")->capture_default_str();
+  sub->add_option("--poses", p.poses,
+                  "'random' (physically plausible placements), or Tejani et al. pose files: a folder of posesN.txt "
+                  "(one mesh), or a folder with a subfolder per mesh named like its file (case, '_' and '-' "
+                  "ignored: juicecarton.stl takes juice_carton/). Image i shows mesh i mod M at the poses of its "
+                  "(i div M)-th file in the order of N, verbatim, on a table fitted under them")
+      ->required();
+  sub->add_option("--images", p.images, "Number of images to render (1 or more)")->required();
+  sub->add_option("--seed", p.seed, "Random seed: the same arguments and seed give the same files")
+      ->capture_default_str();
+  sub->add_option("--out", opt->out, "Output folder (BOP layout); must be empty or new unless --force")->required();
+  sub->add_option("--camera", opt->camera,
+                  "BOP camera.json for the intrinsics and image size (default: Tejani et al.'s PrimeSense, "
+                  "fx 571.97 fy 571.01 cx 319.5 cy 239.5, 640x480)");
+  sub->add_option("--layout", opt->layout, "random: objects on a 'table' or piled in a 'bin'")
+      ->check(CLI::IsMember({"table", "bin"}))
+      ->capture_default_str();
+  sub->add_option("--instances", opt->instances, "random: instances of each mesh per image, N or MIN:MAX")
+      ->capture_default_str();
+  sub->add_option("--clutter", p.clutter, "Boxes and cylinders per image that are not in the ground truth")
+      ->capture_default_str();
+  sub->add_option("--symmetric", p.symmetric,
+                  "obj_id of a mesh with a continuous symmetry about its z axis (models_info.json's "
+                  "symmetries_continuous, so ADI scores it); repeat for several");
+  sub->add_flag("--force", opt->force,
+                "Write into a non-empty --out: removes its models/, test/000001/ and camera.json first");
+  return [opt, &global]() {
+    SynthParams params = opt->params;
+    params.units = parseMeshUnits(opt->units);
+    params.placement.layout = opt->layout == "bin" ? Layout::Bin : Layout::Table;
+    std::tie(params.min_instances, params.max_instances) = parseRange(opt->instances);
+    if (!opt->camera.empty()) params.camera = loadCamera(opt->camera);
+    validateSynthParams(params);  // bad input is exit 1 even on a machine without a device
+    GpuContext ctx(global.gpu());
+    ProgressBar bar("rendering", global.quiet);
+    const SynthSummary s = generateSyntheticDataset(ctx, params, opt->out, opt->force,
+                                                    [&](int done, int total) {
+                                                      bar.update(static_cast<std::size_t>(done),
+                                                                 static_cast<std::size_t>(total));
+                                                    });
+    bar.finish();
+    if (!global.quiet)
+      for (std::size_t i = 0; i < s.mesh_reports.size(); ++i)
+        if (s.mesh_reports[i].inferred)
+          fmt::print("{}: units {} (inferred: the file's diameter is {:.4g} units; pass --units to override)\n",
+                     params.meshes[i], unitName(s.mesh_reports[i].units), s.mesh_reports[i].file_diameter);
+    fmt::print("wrote {} image{} with {} instances of {} object{} to {} ({:.0f} ms per image on {})\n", s.images,
+               s.images == 1 ? "" : "s", s.instances, params.meshes.size(), params.meshes.size() == 1 ? "" : "s",
+               opt->out, s.ms_per_image, ctx.device().name);
+    if (s.left_out > 0)
+      fmt::print("{} random instance{} found no free place and {} left out\n", s.left_out,
+                 s.left_out == 1 ? "" : "s", s.left_out == 1 ? "was" : "were");
+    return kOk;
+  };
+}
+
+}  // namespace vkpose::cli

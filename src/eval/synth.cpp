@@ -1,0 +1,396 @@
+// `vkpose synth`: synthetic BOP datasets. Every random choice of an image comes from one
+// generator seeded with (seed, image index), so images do not depend on each other and the
+// same arguments give the same bytes.
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <deque>
+#include <filesystem>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "vkpose/bop_writer.hpp"
+#include "vkpose/dataset.hpp"
+#include "vkpose/detection_io.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/synth.hpp"
+
+namespace vkpose {
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+/// Object albedos (RGB), one per obj_id in turn: the shared meshes have no colours.
+const Eigen::Vector3f kAlbedos[] = {{0.86f, 0.85f, 0.80f}, {0.95f, 0.55f, 0.15f}, {0.25f, 0.45f, 0.80f},
+                                    {0.80f, 0.22f, 0.20f}, {0.30f, 0.65f, 0.35f}, {0.78f, 0.72f, 0.30f}};
+
+int uniformInt(std::mt19937& rng, int lo, int hi) {
+  return lo + static_cast<int>(rng() % static_cast<uint32_t>(hi - lo + 1));
+}
+
+Eigen::Vector3f randomColour(std::mt19937& rng, float lo, float hi) {
+  return {uniform(rng, lo, hi), uniform(rng, lo, hi), uniform(rng, lo, hi)};
+}
+
+/// "Juice_Carton" and "juicecarton" name the same object.
+std::string normalisedName(const std::string& s) {
+  std::string out;
+  for (const char c : s)
+    if (c != '_' && c != '-' && c != ' ') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+/// N of posesN.txt, or -1 for any other name.
+long poseFileNumber(const fs::path& p) {
+  const std::string name = p.filename().string();
+  if (name.size() <= 9 || name.rfind("poses", 0) != 0 || name.substr(name.size() - 4) != ".txt") return -1;
+  const std::string digits = name.substr(5, name.size() - 9);
+  if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) || digits.size() > 9)
+    return -1;
+  return std::stol(digits);
+}
+
+std::vector<std::string> poseFilesIn(const fs::path& dir) {
+  std::vector<std::pair<long, std::string>> files;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (const long n = poseFileNumber(it->path()); n >= 0 && it->is_regular_file(ec))
+      files.emplace_back(n, it->path().string());
+  std::sort(files.begin(), files.end());
+  std::vector<std::string> out;
+  for (auto& f : files) out.push_back(std::move(f.second));
+  return out;
+}
+
+/// Refuses a non-empty out_dir without overwrite; with it, removes what synth writes there.
+void prepareOutput(const fs::path& out, bool overwrite) {
+  std::error_code ec;
+  if (fs::exists(out, ec)) {
+    if (!fs::is_directory(out, ec)) throw InputError(fmt::format("{} exists and is not a folder", out.string()));
+    if (!fs::is_empty(out, ec)) {
+      if (!overwrite) throw InputError(fmt::format("{} exists and is not empty; pass --force to overwrite it", out.string()));
+      for (const fs::path& p : {out / "models", out / "test" / "000001", out / "camera.json"}) fs::remove_all(p, ec);
+    }
+  }
+  for (const fs::path& p : {out / "models", out / "test" / "000001" / "rgb", out / "test" / "000001" / "depth"}) {
+    fs::create_directories(p, ec);
+    if (ec) throw InputError(fmt::format("cannot create {} ({})", p.string(), ec.message()));
+  }
+}
+
+/// One image's scene: ground-truth instances first, then what is not in the ground truth.
+struct ImageScene {
+  std::vector<SceneObject> objects;
+  std::vector<int> obj_ids;  ///< of the first obj_ids.size() objects: the ground truth
+  int left_out = 0;
+  std::deque<Mesh> owned;    ///< table, bin and clutter meshes (a deque: pointers stay valid)
+  Pose camera_T_world;
+
+  void add(Mesh mesh, const Pose& world_T_object) {
+    owned.push_back(std::move(mesh));
+    objects.push_back({&owned.back(), compose(camera_T_world, world_T_object)});
+  }
+};
+
+/// A table under everything the camera sees (a plane of 5 cm tiles at height z), up to 8 m across.
+void addTable(ImageScene& s, const Camera& camera, float z, std::mt19937& rng) {
+  const Pose world_T_camera = invert(s.camera_T_world);
+  float reach = 0.f;
+  for (const auto& [u, v] : {std::pair{0, 0}, {camera.width, 0}, {0, camera.height}, {camera.width, camera.height}}) {
+    const Eigen::Vector3f ray = world_T_camera.R * Eigen::Vector3f(static_cast<float>((u - camera.cx) / camera.fx),
+                                                                   static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+    const Eigen::Vector3f& o = world_T_camera.t;
+    if (ray.z() >= -1e-3f) {
+      reach = 4.f;
+      break;
+    }
+    const Eigen::Vector3f hit = o + ((z - o.z()) / ray.z()) * ray;
+    reach = std::max({reach, std::abs(hit.x()), std::abs(hit.y())});
+  }
+  Mesh table = planeMesh(std::min(8.f, 2.f * reach + 0.2f));
+  const float grey = uniform(rng, 0.3f, 0.75f);
+  table.colours.assign(table.vertices.size(), grey * Eigen::Vector3f(uniform(rng, 0.9f, 1.1f), 1.f, uniform(rng, 0.8f, 1.f)));
+  Pose at;
+  at.t.z() = z;
+  s.add(std::move(table), at);
+}
+
+/// A box or a cylinder of a random size and colour: things on a table that are not the objects.
+Mesh clutterMesh(std::mt19937& rng) {
+  const Eigen::Vector3f colour = randomColour(rng, 0.1f, 0.9f);
+  if (rng() % 2)
+    return cuboidMesh({uniform(rng, 0.03f, 0.14f), uniform(rng, 0.03f, 0.14f), uniform(rng, 0.02f, 0.12f)}, colour);
+  return cylinderMesh(uniform(rng, 0.02f, 0.05f), uniform(rng, 0.04f, 0.15f), colour);
+}
+
+/// Places clutter clear of `obstacles`, and adds it to the scene.
+void addClutter(ImageScene& s, const SynthParams& p, const PlacementParams& placement,
+                const std::vector<OrientedBox>& obstacles, std::mt19937& rng) {
+  std::vector<Mesh> meshes;
+  for (int i = 0; i < p.clutter; ++i) meshes.push_back(clutterMesh(rng));
+  std::vector<const Mesh*> pointers;
+  for (const auto& m : meshes) pointers.push_back(&m);
+  const auto poses = placeObjects(pointers, obstacles, placement, p.camera, s.camera_T_world, rng);
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (poses[i]) s.add(std::move(meshes[i]), *poses[i]);
+}
+
+ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, std::mt19937& rng) {
+  ImageScene s;
+  s.camera_T_world = randomCamera(p.camera_range, rng);
+  std::vector<OrientedBox> obstacles;
+  if (p.placement.layout == Layout::Bin) obstacles = binWalls(p.placement);
+  std::vector<int> order;  // model indices, shuffled so no object is always placed first
+  for (std::size_t m = 0; m < models.size(); ++m)
+    for (int k = uniformInt(rng, p.min_instances, p.max_instances); k > 0; --k) order.push_back(static_cast<int>(m));
+  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng() % i]);
+  std::vector<const Mesh*> meshes;
+  for (const int m : order) meshes.push_back(&models[static_cast<std::size_t>(m)]);
+  const auto poses = placeObjects(meshes, obstacles, p.placement, p.camera, s.camera_T_world, rng);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (!poses[i]) {
+      ++s.left_out;
+      continue;
+    }
+    s.objects.push_back({meshes[i], compose(s.camera_T_world, *poses[i])});
+    s.obj_ids.push_back(order[i] + 1);
+    obstacles.push_back(orientedBox(*meshes[i], *poses[i]));
+  }
+  addClutter(s, p, p.placement, obstacles, rng);
+  if (p.placement.layout == Layout::Bin) {
+    const Eigen::Vector3f colour = randomColour(rng, 0.2f, 0.7f);
+    for (const OrientedBox& wall : binWalls(p.placement)) {
+      Pose at;
+      at.t = wall.centre;
+      s.add(cuboidMesh(2.f * wall.half, colour), at);
+    }
+    const float floor = p.placement.bin_wall_thickness_m;
+    Pose at;
+    at.t.z() = -0.5f * floor;
+    s.add(cuboidMesh({p.placement.bin_inner_m.x() + 2 * floor, p.placement.bin_inner_m.y() + 2 * floor, floor}, colour),
+          at);
+    addTable(s, p.camera, -floor - 0.001f, rng);
+  } else {
+    addTable(s, p.camera, 0.f, rng);
+  }
+  return s;
+}
+
+/// Tejani poses verbatim; the table under them, clutter around them.
+ImageScene tejaniScene(const SynthParams& p, const Mesh& model, int obj_id, const std::vector<Pose>& camera_T_object,
+                       std::mt19937& rng) {
+  ImageScene s;
+  std::vector<const Mesh*> meshes(camera_T_object.size(), &model);
+  s.camera_T_world = camera_T_object.empty() ? randomCamera(p.camera_range, rng) : supportFrame(meshes, camera_T_object);
+  const Pose world_T_camera = invert(s.camera_T_world);
+  std::vector<OrientedBox> obstacles;
+  for (const Pose& pose : camera_T_object) {
+    s.objects.push_back({&model, pose});
+    s.obj_ids.push_back(obj_id);
+    obstacles.push_back(orientedBox(model, compose(world_T_camera, pose)));
+  }
+  PlacementParams table = p.placement;
+  table.layout = Layout::Table;
+  addClutter(s, p, table, obstacles, rng);
+  addTable(s, p.camera, 0.f, rng);
+  return s;
+}
+
+/// A light from above the table at a random elevation and azimuth, random exposure and tint.
+Lighting randomLighting(const Pose& camera_T_world, std::mt19937& rng) {
+  const float elevation = uniform(rng, 30.f, 90.f) * kPi / 180.f, azimuth = uniform(rng, 0.f, 2.f * kPi);
+  const Eigen::Vector3f from(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                             std::sin(elevation));
+  Lighting light;
+  light.direction = camera_T_world.R * -from;
+  light.ambient = uniform(rng, 0.2f, 0.45f);
+  light.diffuse = uniform(rng, 0.5f, 0.8f);
+  light.specular = uniform(rng, 0.f, 0.25f);
+  light.shininess = uniform(rng, 8.f, 40.f);
+  const float exposure = uniform(rng, 0.8f, 1.15f);
+  light.gain = exposure * randomColour(rng, 0.94f, 1.06f);
+  return light;
+}
+
+/// The ground-truth entries of one rendered image.
+void groundTruth(const ImageScene& s, const SceneRendering& r, const LinemodFrame& frame,
+                 std::vector<GroundTruthPose>& gt, std::vector<GroundTruthInfo>& info) {
+  for (std::size_t i = 0; i < s.obj_ids.size(); ++i) {
+    GroundTruthPose g;
+    g.obj_id = s.obj_ids[i];
+    g.R = s.objects[i].pose.R;
+    g.t = s.objects[i].pose.t;
+    gt.push_back(g);
+    GroundTruthInfo n;
+    const cv::Mat& full = r.full_masks[i];
+    const cv::Mat visible = r.instance == static_cast<uint16_t>(i + 1);
+    n.px_count_all = r.full_pixels[i];
+    n.px_count_visib = r.visible_pixels[i];
+    n.px_count_valid = cv::countNonZero(full & (frame.depth_mm > 0));
+    n.bbox_obj = n.px_count_all > 0 ? cv::boundingRect(full) : cv::Rect(-1, -1, -1, -1);
+    n.bbox_visib = n.px_count_visib > 0 ? cv::boundingRect(visible) : cv::Rect(-1, -1, -1, -1);
+    n.visib_fract = r.visibleFraction(i);
+    g.visib_fract = n.visib_fract;
+    info.push_back(n);
+  }
+}
+
+}  // namespace
+
+Camera tejaniCamera() {
+  Camera c;
+  c.fx = 571.9737;
+  c.fy = 571.0073;
+  c.cx = 319.5;
+  c.cy = 239.5;
+  c.width = 640;
+  c.height = 480;
+  c.depth_scale = 1.0;
+  return c;
+}
+
+DepthNoiseParams synthNoise() {
+  DepthNoiseParams n;
+  n.grazing_start_deg = 65.f;
+  n.grazing_dropout = 0.9f;
+  n.holes = 8;
+  n.hole_radius_px[0] = 2.f;
+  n.hole_radius_px[1] = 10.f;
+  n.max_range_m = 4.f;
+  return n;
+}
+
+void validateSynthParams(const SynthParams& p) {
+  if (p.meshes.empty()) throw InputError("synth needs at least one mesh");
+  if (p.images < 1) throw InputError(fmt::format("--images must be 1 or more, not {}", p.images));
+  if (p.min_instances < 0 || p.max_instances < p.min_instances || p.max_instances > 50)
+    throw InputError(fmt::format("instances per mesh {}..{}: need 0 <= min <= max <= 50", p.min_instances,
+                                 p.max_instances));
+  if (p.clutter < 0 || p.clutter > 50) throw InputError(fmt::format("clutter {} is outside 0..50", p.clutter));
+  for (const int id : p.symmetric)
+    if (id < 1 || id > static_cast<int>(p.meshes.size()))
+      throw InputError(fmt::format("--symmetric {}: obj_ids are 1..{} (the meshes in order)", id, p.meshes.size()));
+  if (p.poses != "random") {
+    std::error_code ec;
+    if (!fs::is_directory(p.poses, ec))
+      throw InputError(fmt::format("--poses {}: neither 'random' nor a folder of pose files", p.poses));
+    if (p.placement.layout == Layout::Bin)
+      throw InputError("the bin layout places objects itself: use it with --poses random");
+  }
+  validateCamera(p.camera, "synth camera");
+}
+
+std::vector<std::vector<std::string>> tejaniPoseFiles(const std::string& dir,
+                                                      const std::vector<std::string>& mesh_names) {
+  const fs::path root(dir);
+  if (std::vector<std::string> own = poseFilesIn(root); !own.empty()) {
+    if (mesh_names.size() != 1)
+      throw InputError(fmt::format("{} holds pose files of one object, but {} meshes were given: pass its parent "
+                                   "folder, with a folder per mesh",
+                                   dir, mesh_names.size()));
+    return {own};
+  }
+  std::vector<fs::path> folders;
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_directory(ec)) folders.push_back(it->path());
+  std::sort(folders.begin(), folders.end());
+  std::vector<std::vector<std::string>> out;
+  for (const auto& name : mesh_names) {
+    const auto it = std::find_if(folders.begin(), folders.end(), [&](const fs::path& f) {
+      return normalisedName(f.filename().string()) == normalisedName(name);
+    });
+    if (it == folders.end()) {
+      std::string have;
+      for (const auto& f : folders) have += (have.empty() ? "" : ", ") + f.filename().string();
+      throw InputError(fmt::format("{}: no pose files (posesN.txt) and no folder for mesh '{}' (folders: {})", dir,
+                                   name, have.empty() ? "none" : have));
+    }
+    std::vector<std::string> files = poseFilesIn(*it);
+    if (files.empty()) throw InputError(fmt::format("{}: no pose files (posesN.txt)", it->string()));
+    out.push_back(std::move(files));
+  }
+  return out;
+}
+
+SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& p, const std::string& out_dir,
+                                      bool overwrite, const std::function<void(int, int)>& progress) {
+  validateSynthParams(p);
+  SynthSummary summary;
+  std::vector<Mesh> models;
+  for (std::size_t i = 0; i < p.meshes.size(); ++i) {
+    MeshLoadReport report;
+    Mesh m = loadMesh(p.meshes[i], p.units, &report);
+    m.colours.assign(m.vertices.size(), kAlbedos[i % std::size(kAlbedos)]);  // rendered as albedo, lit later
+    models.push_back(std::move(m));
+    summary.mesh_reports.push_back(report);
+  }
+  // Tejani: every pose file an image needs, read (and so checked) before anything is written.
+  std::vector<std::vector<Pose>> tejani(static_cast<std::size_t>(p.images));
+  if (p.poses != "random") {
+    std::vector<std::string> names;
+    for (const auto& m : models) names.push_back(m.name);
+    const auto files = tejaniPoseFiles(p.poses, names);
+    const std::size_t M = models.size();
+    for (std::size_t i = 0; i < tejani.size(); ++i) {
+      const auto& list = files[i % M];
+      const std::size_t needed = (static_cast<std::size_t>(p.images) - 1 - i % M) / M + 1;
+      if (list.size() < needed)
+        throw InputError(fmt::format("--images {} needs {} pose files for '{}', {} has {}", p.images, needed,
+                                     models[i % M].name, fs::path(list.front()).parent_path().string(), list.size()));
+      tejani[i] = loadTejaniPoses(list[i / M]);
+    }
+  }
+
+  Camera camera = p.camera;
+  camera.depth_scale = 1.0;  // the depth PNGs are written in millimetres
+  const fs::path out(out_dir), scene_dir = out / "test" / "000001";
+  prepareOutput(out, overwrite);
+  std::vector<BopModel> bop_models;
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const int obj_id = static_cast<int>(i) + 1;
+    BopModel bm{obj_id, &models[i], {}};
+    if (std::find(p.symmetric.begin(), p.symmetric.end(), obj_id) != p.symmetric.end())
+      bm.symmetries.push_back({Eigen::Vector3f::UnitZ(), models[i].bboxCentre()});
+    bop_models.push_back(bm);
+    writePlyMillimetres(models[i], (out / "models" / fmt::format("obj_{:06d}.ply", obj_id)).string(), false);
+  }
+  writeTextFile((out / "models" / "models_info.json").string(), modelsInfoJson(bop_models), false);
+  writeTextFile((out / "camera.json").string(), cameraJson(camera), false);
+
+  std::map<int, std::vector<GroundTruthPose>> gt;
+  std::map<int, std::vector<GroundTruthInfo>> info;
+  std::map<int, Camera> cameras;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < p.images; ++i) {
+    std::seed_seq seq{p.seed, static_cast<uint32_t>(i), 0x5e7du};
+    std::mt19937 rng(seq);
+    const std::size_t m = static_cast<std::size_t>(i) % models.size();
+    ImageScene s = p.poses == "random"
+                       ? randomScene(p, models, rng)
+                       : tejaniScene(p, models[m], static_cast<int>(m) + 1, tejani[static_cast<std::size_t>(i)], rng);
+    summary.left_out += s.left_out;
+    SceneRendering r = renderScene(ctx, s.objects, camera);
+    applyLighting(r, randomLighting(s.camera_T_world, rng));
+    const LinemodFrame frame = sensorFrame(r, p.noise, static_cast<uint32_t>(rng()));
+    groundTruth(s, r, frame, gt[i], info[i]);
+    cameras[i] = camera;
+    summary.instances += static_cast<int>(s.obj_ids.size());
+    writeImage((scene_dir / "rgb" / fmt::format("{:06d}.png", i)).string(), frame.bgr, false);
+    writeImage((scene_dir / "depth" / fmt::format("{:06d}.png", i)).string(), frame.depth_mm, false);
+    if (progress) progress(i + 1, p.images);
+  }
+  writeTextFile((scene_dir / "scene_gt.json").string(), sceneGtJson(gt), false);
+  writeTextFile((scene_dir / "scene_gt_info.json").string(), sceneGtInfoJson(info), false);
+  writeTextFile((scene_dir / "scene_camera.json").string(), sceneCameraJson(cameras), false);
+  summary.images = p.images;
+  summary.ms_per_image =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / p.images;
+  return summary;
+}
+
+}  // namespace vkpose

@@ -1,0 +1,322 @@
+// `vkpose synth`: reproducible bytes, a BOP dataset the reader loads with boxes that match the
+// poses, placements that never intersect and rest on the table or in the bin, Tejani poses
+// taken verbatim, and clear errors for bad input.
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+#include "mesh_support.hpp"
+#include "test_support.hpp"
+#include "vkpose/bop_writer.hpp"
+#include "vkpose/dataset.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/synth.hpp"
+
+namespace vkpose {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path freshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("vkpose_synth_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+/// An L-shaped part (no symmetry, one unstable side) as a PLY in millimetres.
+std::string lPartPly() {
+  static const std::string path = [] {
+    const fs::path dir = freshDir("meshes");
+    fs::create_directories(dir);
+    const std::string p = (dir / "l_part.ply").string();
+    writePlyMillimetres(test::lShapeMesh(), p, true);
+    return p;
+  }();
+  return path;
+}
+
+SynthParams smallParams(uint32_t seed) {
+  SynthParams p;
+  p.meshes = {lPartPly()};
+  p.units = MeshUnits::Millimetres;
+  p.images = 2;
+  p.seed = seed;
+  p.min_instances = 2;
+  p.max_instances = 3;
+  p.clutter = 3;
+  p.camera.width = 320;
+  p.camera.height = 240;
+  p.camera.cx = 159.5;
+  p.camera.cy = 119.5;
+  p.camera.fx = p.camera.fy = 286.0;
+  return p;
+}
+
+std::map<std::string, std::string> filesUnder(const fs::path& root) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.is_regular_file()) {
+      std::ifstream in(e.path(), std::ios::binary);
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      out[fs::relative(e.path(), root).string()] = bytes.str();
+    }
+  return out;
+}
+
+/// Box of the mesh's vertices projected at a pose, clipped to the image.
+cv::Rect projectedBox(const Mesh& mesh, const GroundTruthPose& g, const Camera& c) {
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  for (const auto& v : mesh.vertices) {
+    const Eigen::Vector2f p = c.project(g.R * v + g.t);
+    x0 = std::min(x0, p.x()), y0 = std::min(y0, p.y()), x1 = std::max(x1, p.x()), y1 = std::max(y1, p.y());
+  }
+  const cv::Rect box(cv::Point(static_cast<int>(std::floor(x0)), static_cast<int>(std::floor(y0))),
+                     cv::Point(static_cast<int>(std::ceil(x1)) + 1, static_cast<int>(std::ceil(y1)) + 1));
+  return box & cv::Rect(0, 0, c.width, c.height);
+}
+
+TEST(SynthDataset, SameSeedSameBytesOtherSeedOtherBytes) {
+  const fs::path a = freshDir("a"), b = freshDir("b"), c = freshDir("c");
+  generateSyntheticDataset(test::context(), smallParams(7), a.string(), false);
+  generateSyntheticDataset(test::context(), smallParams(7), b.string(), false);
+  generateSyntheticDataset(test::context(), smallParams(8), c.string(), false);
+  const auto fa = filesUnder(a), fb = filesUnder(b), fc = filesUnder(c);
+  ASSERT_EQ(fa.size(), 10u);  // models: ply + info; camera.json; 2 rgb + 2 depth; 3 scene files
+  ASSERT_EQ(fb.size(), fa.size());
+  for (const auto& [name, bytes] : fa) {
+    ASSERT_TRUE(fb.count(name)) << name;
+    EXPECT_TRUE(fb.at(name) == bytes) << name << " differs between two runs with the same seed";
+  }
+  for (const char* name : {"test/000001/rgb/000000.png", "test/000001/depth/000001.png", "test/000001/scene_gt.json"})
+    EXPECT_FALSE(fc.at(name) == fa.at(name)) << name << " is the same with another seed";
+  for (const auto& d : {a, b, c}) fs::remove_all(d);
+}
+
+TEST(SynthDataset, LoadsAsBopAndEveryPoseProjectsOntoItsBoxes) {
+  const fs::path dir = freshDir("bop");
+  SynthParams p = smallParams(3);
+  p.symmetric = {1};
+  const SynthSummary s = generateSyntheticDataset(test::context(), p, dir.string(), false);
+  const BopDataset ds = loadBopDataset(dir.string());
+  ASSERT_EQ(ds.images.size(), 2u);
+  ASSERT_EQ(ds.models.size(), 1u);
+  EXPECT_TRUE(ds.models.at(1).symmetric);
+  const Mesh model = loadMesh(ds.modelPath(1), MeshUnits::Millimetres);
+  const Mesh original = test::lShapeMesh();
+  EXPECT_NEAR(ds.models.at(1).diameter, original.diameter, 1e-5f);
+  EXPECT_LT((model.bbox_min - original.bbox_min).norm(), 1e-5f);
+  int instances = 0;
+  for (const BopImage& im : ds.images) {
+    EXPECT_EQ(im.camera.width, 320);
+    EXPECT_EQ(im.camera.depth_scale, 1.0);
+    ASSERT_EQ(im.gt.size(), im.gt_info.size());
+    EXPECT_GE(im.gt.size(), 2u);
+    const cv::Mat depth = cv::imread(im.depth_path, cv::IMREAD_ANYDEPTH);
+    for (std::size_t i = 0; i < im.gt.size(); ++i) {
+      const GroundTruthInfo& info = im.gt_info[i];
+      ++instances;
+      ASSERT_GT(info.px_count_visib, 0) << "placements stand where the camera sees them";
+      const cv::Rect projected = projectedBox(model, im.gt[i], im.camera);
+      EXPECT_EQ((info.bbox_visib & projected), info.bbox_visib) << "image " << im.image_id << " instance " << i;
+      EXPECT_EQ((info.bbox_obj & projected), info.bbox_obj) << "image " << im.image_id << " instance " << i;
+      EXPECT_EQ((info.bbox_visib & info.bbox_obj), info.bbox_visib);
+      EXPECT_GE(info.px_count_all, info.px_count_visib);
+      EXPECT_LE(info.px_count_valid, info.px_count_all);
+      EXPECT_NEAR(info.visib_fract, static_cast<float>(info.px_count_visib) / static_cast<float>(info.px_count_all),
+                  1e-6f);
+      // The sensor sees the object's centre's depth near where the pose puts it.
+      const Eigen::Vector3f centre = im.gt[i].R * model.bboxCentre() + im.gt[i].t;
+      EXPECT_GT(centre.z(), 0.5f);
+      EXPECT_LT(centre.z(), 2.0f);
+    }
+    EXPECT_GT(cv::countNonZero(depth), depth.total() / 2) << "the table fills the view";
+  }
+  EXPECT_EQ(instances, s.instances);
+  fs::remove_all(dir);
+}
+
+/// Any vertex of `a` inside the bounding box of `b` (b's frame): a check of placements that
+/// does not use the separating-axis test they were made with.
+bool vertexInside(const Mesh& a, const Pose& wa, const Mesh& b, const Pose& wb) {
+  const Pose b_T_a = compose(invert(wb), wa);
+  for (const auto& v : a.vertices) {
+    const Eigen::Vector3f p = b_T_a.R * v + b_T_a.t;
+    if ((p.array() > b.bbox_min.array()).all() && (p.array() < b.bbox_max.array()).all()) return true;
+  }
+  return false;
+}
+
+float lowestZ(const Mesh& m, const Pose& w) {
+  float z = 1e9f;
+  for (const auto& v : m.vertices) z = std::min(z, (w.R * v + w.t).z());
+  return z;
+}
+
+TEST(SynthPlacement, TableObjectsRestOnItAndNeverIntersect) {
+  const Mesh part = test::lShapeMesh(), box = test::boxMesh({0.06f, 0.04f, 0.1f}), sphere = test::icosphere(0.04f, 2);
+  const std::vector<const Mesh*> meshes{&part, &box, &sphere, &part, &box, &part, &sphere, &part};
+  const Camera camera = tejaniCamera();
+  int placed = 0;
+  for (uint32_t seed = 0; seed < 20; ++seed) {
+    std::mt19937 rng(seed);
+    const Pose camera_T_world = randomCamera({}, rng);
+    PlacementParams params;
+    const auto poses = placeObjects(meshes, {}, params, camera, camera_T_world, rng);
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+      if (!poses[i]) continue;
+      ++placed;
+      EXPECT_NEAR(lowestZ(*meshes[i], *poses[i]), 0.f, 1e-4f) << "seed " << seed << " object " << i;
+      const Eigen::Vector3f centre = compose(camera_T_world, *poses[i]).t;
+      EXPECT_GT(centre.z(), 0.3f);
+      for (std::size_t j = 0; j < i; ++j) {
+        if (!poses[j]) continue;
+        EXPECT_FALSE(vertexInside(*meshes[i], *poses[i], *meshes[j], *poses[j])) << seed << ": " << i << ", " << j;
+        EXPECT_FALSE(vertexInside(*meshes[j], *poses[j], *meshes[i], *poses[i])) << seed << ": " << j << ", " << i;
+      }
+    }
+  }
+  EXPECT_GT(placed, 20 * 7) << "nearly every object finds a place";
+}
+
+TEST(SynthPlacement, BinPilesStayInsideAndNeverIntersect) {
+  const Mesh part = test::lShapeMesh(), box = test::boxMesh({0.06f, 0.04f, 0.1f});
+  const std::vector<const Mesh*> meshes(12, &part);
+  PlacementParams params;
+  params.layout = Layout::Bin;
+  int above_floor = 0;
+  for (uint32_t seed = 0; seed < 5; ++seed) {
+    std::mt19937 rng(seed);
+    const auto poses = placeObjects(meshes, binWalls(params), params, tejaniCamera(), randomCamera({}, rng), rng);
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+      ASSERT_TRUE(poses[i]) << "12 parts fit in the bin";
+      const float low = lowestZ(part, *poses[i]);
+      EXPECT_GE(low, 0.f);
+      above_floor += low > 0.01f;
+      for (const auto& v : part.vertices) {
+        const Eigen::Vector3f w = poses[i]->R * v + poses[i]->t;
+        EXPECT_LE(std::abs(w.x()), 0.5f * params.bin_inner_m.x());
+        EXPECT_LE(std::abs(w.y()), 0.5f * params.bin_inner_m.y());
+      }
+      for (std::size_t j = 0; j < i; ++j)
+        EXPECT_FALSE(vertexInside(part, *poses[i], part, *poses[j]) || vertexInside(part, *poses[j], part, *poses[i]))
+            << seed << ": " << i << ", " << j;
+    }
+  }
+  EXPECT_GT(above_floor, 0) << "some parts settle on others: a pile, not a layer";
+}
+
+TEST(SynthPlacement, RestingOrientationsAreStable) {
+  // A box rests on any face; the most likely ones keep its centre low.
+  const auto box = restingOrientations(test::boxMesh({0.1f, 0.04f, 0.02f}));
+  EXPECT_EQ(box.size(), 6u);
+  // An L: resting on the end of its short leg tips over, so fewer faces are stable.
+  const Mesh l = test::lShapeMesh();
+  const auto rest = restingOrientations(l);
+  EXPECT_LT(rest.size(), 6u);
+  for (const auto& r : rest) EXPECT_NEAR(lowestZ(l, {r.R, Eigen::Vector3f(0.f, 0.f, r.lift_m)}), 0.f, 1e-5f);
+}
+
+TEST(SynthTejani, PosesAreUsedVerbatim) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string data = test::sharedData();
+  const fs::path dir = freshDir("tejani");
+  SynthParams p;
+  p.meshes = {data + "/meshes/coffee_cup.stl", data + "/meshes/juicecarton.stl"};
+  p.poses = data + "/tejani_poses";
+  p.images = 3;
+  p.clutter = 2;
+  generateSyntheticDataset(test::context(), p, dir.string(), false);
+  const auto files = tejaniPoseFiles(p.poses, {"coffee_cup", "juicecarton"});
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_NE(files[1].front().find("juice_carton"), std::string::npos);
+  const BopDataset ds = loadBopDataset(dir.string());
+  ASSERT_EQ(ds.images.size(), 3u);
+  for (const BopImage& im : ds.images) {
+    const std::size_t m = static_cast<std::size_t>(im.image_id) % 2, k = static_cast<std::size_t>(im.image_id) / 2;
+    const std::vector<Pose> poses = loadTejaniPoses(files[m][k]);
+    ASSERT_EQ(im.gt.size(), poses.size()) << files[m][k];
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      EXPECT_EQ(im.gt[i].obj_id, static_cast<int>(m) + 1);
+      EXPECT_LT((im.gt[i].R - poses[i].R).cwiseAbs().maxCoeff(), 1e-6f);
+      EXPECT_LT((im.gt[i].t - poses[i].t).cwiseAbs().maxCoeff(), 1e-6f);
+      EXPECT_GT(im.gt_info[i].px_count_visib, 0);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SynthTejani, TheTableIsUnderTheInstances) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string data = test::sharedData();
+  const Mesh cup = loadMesh(data + "/meshes/coffee_cup.stl");
+  const auto files = tejaniPoseFiles(data + "/tejani_poses/coffee_cup", {"coffee_cup"});
+  for (std::size_t f = 0; f < 10; ++f) {
+    const std::vector<Pose> poses = loadTejaniPoses(files[0][f]);
+    const Pose world_T_camera = invert(supportFrame(std::vector<const Mesh*>(poses.size(), &cup), poses));
+    float lowest = 1e9f;
+    for (const Pose& pose : poses) {
+      const float z = lowestZ(cup, compose(world_T_camera, pose));
+      EXPECT_GE(z, -1e-4f);
+      EXPECT_LT(z, 0.02f) << files[0][f] << ": every cup stands on the table";
+      lowest = std::min(lowest, z);
+    }
+    EXPECT_NEAR(lowest, 0.f, 1e-4f);
+    EXPECT_GT(world_T_camera.t.z(), 0.3f) << "the camera is above the table";
+  }
+}
+
+TEST(SynthBadInput, ClearErrors) {
+  const fs::path dir = freshDir("bad"), out = dir / "out";
+  fs::create_directories(dir / "empty");
+  auto run = [&](const SynthParams& p) {
+    return test::inputErrorOf([&] { generateSyntheticDataset(test::context(), p, out.string(), false); });
+  };
+  SynthParams p = smallParams(1);
+  p.meshes = {(dir / "missing.stl").string()};
+  EXPECT_NE(run(p).find("missing.stl"), std::string::npos);
+  p = smallParams(1);
+  p.images = 0;
+  EXPECT_NE(run(p).find("--images"), std::string::npos);
+  p = smallParams(1);
+  p.symmetric = {2};
+  EXPECT_NE(run(p).find("--symmetric 2"), std::string::npos);
+  p = smallParams(1);
+  p.poses = (dir / "empty").string();
+  EXPECT_NE(run(p).find("no pose files"), std::string::npos);
+  p.poses = (dir / "nowhere").string();
+  EXPECT_NE(run(p).find("nowhere"), std::string::npos);
+  // A pose file whose count does not match its matrices.
+  fs::create_directories(dir / "poses");
+  std::ofstream(dir / "poses" / "poses1.txt") << "2\n1 0 0 0\n0 1 0 0\n0 0 1 0.8\n0 0 0 1\n";
+  p.poses = (dir / "poses").string();
+  p.images = 1;
+  EXPECT_NE(run(p).find("poses1.txt"), std::string::npos);
+  // Fewer pose files than images.
+  std::ofstream(dir / "poses" / "poses1.txt", std::ios::trunc) << "1\n1 0 0 0\n0 1 0 0\n0 0 1 0.8\n0 0 0 1\n";
+  p.images = 2;
+  EXPECT_NE(run(p).find("needs 2 pose files"), std::string::npos);
+  p.placement.layout = Layout::Bin;
+  EXPECT_NE(run(p).find("bin"), std::string::npos);
+  EXPECT_NE(test::inputErrorOf([] { parseMeshUnits("inches"); }).find("inches"), std::string::npos);
+  // An output folder with something in it is never overwritten without being asked.
+  fs::create_directories(out);
+  std::ofstream(out / "keep.txt") << "mine";
+  p = smallParams(1);
+  p.images = 1;
+  EXPECT_NE(run(p).find("--force"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out / "models"));
+  generateSyntheticDataset(test::context(), p, out.string(), true);
+  EXPECT_TRUE(fs::exists(out / "keep.txt")) << "--force removes only what synth writes";
+  EXPECT_TRUE(fs::exists(out / "test" / "000001" / "rgb" / "000000.png"));
+  EXPECT_FALSE(fs::exists(dir / "empty" / "models")) << "nothing is written before the input is checked";
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vkpose
