@@ -159,7 +159,7 @@ TEST(InitialTranslation, ABlackHoleIsRejectedWithAReason) {
   c.scene_depth.setTo(0.f);
   const InitialPose p = initialTranslation(c.rendering, c.rendered, c.scene_depth, c.camera, c.box.diameter);
   EXPECT_FALSE(p.ok);
-  EXPECT_NE(p.why.find("no depth"), std::string::npos) << p.why;
+  EXPECT_NE(p.why.find("have scene depth near it"), std::string::npos) << p.why;
   EXPECT_TRUE(p.scene_points.empty());
   // A rendering of another size is a caller's mistake, reported as such.
   const cv::Mat small(10, 10, CV_32FC1, cv::Scalar(0.5f));

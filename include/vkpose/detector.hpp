@@ -24,9 +24,17 @@ struct DetectorParams {
   ClusterParams cluster;
   ScoreParams score;
   NmsParams nms;
-  /// Hypotheses whose cluster score gamma is below this are dropped before NMS (a cluster on
-  /// clutter, a template that fits the colour edges but not the depth).
+  /// Without stages 6-8 (estimate_poses false): hypotheses whose cluster score gamma is below
+  /// this are dropped before NMS (a cluster on clutter, a template that fits the colour edges
+  /// but not the depth).
   float min_score = 0.15f;
+  /// With stages 6-8: hypotheses with gamma from this up go through NMS within their object,
+  /// and the best pose_candidates_per_object of each object get a pose; verification, not
+  /// gamma, then decides. On real Kinect depth at 1 m, gamma of a correct hypothesis can be as
+  /// low as 0.13 (LM-O), and a cluttered object's best hypothesis can rank below hundreds of
+  /// other objects' ones, so one global gamma cut and NMS across objects would lose it.
+  float pose_min_score = 0.05f;
+  int pose_candidates_per_object = 16;
   /// Stages 6-8 (initial pose, MLS + ICP, octree verification). false: stop after NMS and
   /// report the best template's pose, unverified.
   bool estimate_poses = true;
@@ -47,7 +55,10 @@ void validateDetectorParams(const DetectorParams& params);
 struct Detection {
   int bank = 0;
   std::string object;         ///< the bank's object name
-  float score = 0.f;          ///< gamma
+  /// gamma without stages 6-8; with them the verification score
+  /// phi * (1 - see-through share) * silhouette support
+  float score = 0.f;
+  float gamma = 0.f;          ///< cluster score alpha * beta
   float alpha = 0.f, beta = 0.f;
   float x = 0.f, y = 0.f;     ///< image position of the object's centre
   cv::Rect2f bbox;            ///< pixels: the best template's object box
@@ -58,6 +69,9 @@ struct Detection {
   // Stages 6-8; unset (verified false, collision_rate -1) when they did not run.
   bool verified = false;       ///< the refined pose passed verification
   float collision_rate = -1.f; ///< phi
+  float see_through = 0.f;     ///< share of the visible model points the camera sees through
+  float depth_fit = 0.f;       ///< share of the visible model points within tolerance of the scene depth
+  float silhouette_support = 0.f;  ///< share of the outline with a depth step behind it
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group

@@ -42,6 +42,9 @@ struct MatchTimings {
   double gpu_ms = 0;      ///< the frame's single submit: features, similarity, refinement
   double finish_ms = 0;   ///< host-side sorting and deduplication
   std::size_t coarse_candidates = 0;
+  /// Submits of the similarity stage: 1 unless the candidates outgrew one GPU buffer and
+  /// the template chunks were split over several passes.
+  std::size_t passes = 0;
 };
 
 namespace gpu {

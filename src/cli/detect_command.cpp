@@ -60,7 +60,16 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str()
       ->group(stages);
-  sub->add_option("--min-score", p.min_score, "Smallest cluster score gamma a hypothesis needs, 0..1")
+  sub->add_option("--pose-candidates", p.pose_candidates_per_object,
+                  "Hypotheses per object that get a pose and verification (the best after NMS)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(stages);
+  sub->add_option("--pose-min-score", p.pose_min_score, "Smallest cluster score gamma a hypothesis needs for a pose, 0..1")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(stages);
+  sub->add_option("--min-score", p.min_score, "With --no-pose: smallest cluster score gamma a detection needs, 0..1")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str()
       ->group(stages);
@@ -120,7 +129,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
 
     fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
                result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
-               result.scored_hypotheses, opt->params.min_score, ctx.device().name);
+               result.scored_hypotheses,
+               opt->params.estimate_poses ? opt->params.pose_min_score : opt->params.min_score, ctx.device().name);
     if (!result.rejected.empty())
       fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
                  result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");
@@ -129,7 +139,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                  "box x,y,w,h (px)", "t (m)", reasons ? "why rejected" : "icp fitness (mm^2)");
       for (std::size_t i = 0; i < dets.size(); ++i) {
         const Detection& d = dets[i];
-        fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6}  {:>20}  {:>24}  {}\n", i + 1, d.object, d.score, d.alpha * d.beta,
+        fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6}  {:>20}  {:>24}  {}\n", i + 1, d.object, d.score, d.gamma,
                    d.collision_rate >= 0.f ? fmt::format("{:.3f}", d.collision_rate) : "-",
                    fmt::format("{:.0f},{:.0f},{:.0f},{:.0f}", d.bbox.x, d.bbox.y, d.bbox.width, d.bbox.height),
                    fmt::format("{:.3f},{:.3f},{:.3f}", d.pose.t.x(), d.pose.t.y(), d.pose.t.z()),

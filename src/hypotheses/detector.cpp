@@ -27,6 +27,7 @@ Detection hypothesisDetection(const Hypothesis& h, const std::vector<TemplateBan
   d.bank = h.bank;
   d.object = bank.object;
   d.score = h.score;
+  d.gamma = h.score;
   d.alpha = h.alpha;
   d.beta = h.beta;
   d.x = h.x;
@@ -87,6 +88,9 @@ Detector::~Detector() = default;
 void validateDetectorParams(const DetectorParams& p) {
   validateScoreParams(p.score);
   if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
+  if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");
+  if (p.pose_candidates_per_object < 1)
+    throw InputError(fmt::format("pose candidates per object must be at least 1, not {}", p.pose_candidates_per_object));
   validateInitialPoseParams(p.initial_pose);
   validateRefineParams(p.refine);
   validateVerifyParams(p.verify);
@@ -141,12 +145,25 @@ DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_
   t0 = std::chrono::steady_clock::now();
   const ScoreScene scene = makeScoreScene(frame.depth_mm, camera);
   scorer_->score(hypotheses, banks_, scene, params_.score);
-  std::erase_if(hypotheses, [&](const Hypothesis& h) { return h.best_member < 0 || h.score < params_.min_score; });
+  const float min_score = params_.estimate_poses ? params_.pose_min_score : params_.min_score;
+  std::erase_if(hypotheses, [&](const Hypothesis& h) { return h.best_member < 0 || h.score < min_score; });
   result.scored_hypotheses = hypotheses.size();
   result.timings_ms.emplace_back("scoring", msSince(t0));
 
   t0 = std::chrono::steady_clock::now();
-  hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, params_.nms);
+  if (params_.estimate_poses) {
+    // Within each object, then the best few of each object (see pose_min_score): objects
+    // compete after verification, in 3D.
+    NmsParams nms = params_.nms;
+    nms.across_objects = false;
+    hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, nms);
+    std::vector<int> taken(banks_.size(), 0);
+    std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
+      return taken[static_cast<std::size_t>(h.bank)]++ >= params_.pose_candidates_per_object;
+    });
+  } else {
+    hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, params_.nms);
+  }
   result.timings_ms.emplace_back("nms", msSince(t0));
 
   if (params_.estimate_poses) {
@@ -232,12 +249,16 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
   // Stage 8: the collision rate of the refined visible model against the raw scene crop.
   t0 = std::chrono::steady_clock::now();
   std::vector<VerifyResult> verified(n);
+  std::vector<DepthAgreement> agreement(n);
+  std::vector<float> support(n, 0.f);
   util::parallelFor(
       n,
       [&](std::size_t i) {
         if (!initial[i].ok) return;
-        verified[i] = verifyPose(transformed(initial[i].model_points, refined[i].pose), initial[i].scene_points,
-                                 params_.verify);
+        const PointCloud model = transformed(initial[i].model_points, refined[i].pose);
+        verified[i] = verifyPose(model, initial[i].scene_points, params_.verify);
+        agreement[i] = depthAgreement(model, scene.depth_m, camera, params_.verify.see_through_tolerance);
+        support[i] = silhouetteSupport(model, scene.depth_m, camera, params_.verify.silhouette_jump);
       },
       params_.threads);
 
@@ -255,10 +276,21 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     d.icp_fitness = refined[i].fitness;
     d.icp_iterations = refined[i].iterations;
     d.collision_rate = verified[i].collision_rate;
+    d.see_through = agreement[i].seen_through;
+    d.depth_fit = agreement[i].fits;
+    d.silhouette_support = support[i];
+    d.score = d.collision_rate * (1.f - d.see_through) * d.silhouette_support;
     placeInImage(d, initial[i].model_points, bank.centre, camera);
-    if (!verified[i].accepted) {
-      d.rejection = fmt::format("collision rate {:.2f} is not above {:.2f}", d.collision_rate,
-                                params_.verify.threshold);
+    const VerifyParams& vp = params_.verify;
+    if (!verified[i].accepted)
+      d.rejection = fmt::format("collision rate {:.2f} is not above {:.2f}", d.collision_rate, vp.threshold);
+    else if (d.see_through > vp.max_see_through)
+      d.rejection = fmt::format("the camera sees through {:.0f}% of the model (at most {:.0f}%)", 100 * d.see_through,
+                                100 * vp.max_see_through);
+    else if (d.silhouette_support < vp.min_silhouette_support)
+      d.rejection = fmt::format("only {:.0f}% of the outline shows a depth step (at least {:.0f}%)",
+                                100 * d.silhouette_support, 100 * vp.min_silhouette_support);
+    if (!d.rejection.empty()) {
       result.rejected.push_back(std::move(d));
       continue;
     }

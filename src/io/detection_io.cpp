@@ -44,7 +44,11 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
   j["R"] = R;
   j["t"] = {round(d.pose.t.x(), 6), round(d.pose.t.y(), 6), round(d.pose.t.z(), 6)};
   if (d.collision_rate >= 0.f) {
+    j["gamma"] = round(d.gamma, 4);
     j["collision_rate"] = round(d.collision_rate, 4);
+    j["see_through"] = round(d.see_through, 4);
+    j["depth_fit"] = round(d.depth_fit, 4);
+    j["silhouette_support"] = round(d.silhouette_support, 4);
     j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision
     j["icp_iterations"] = d.icp_iterations;
     j["rotation_votes"] = d.rotation_votes;

@@ -44,16 +44,36 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
     uploaded_for_ = size;
     timings_.upload_ms = msSince(t0);
   }
-  std::vector<match::CoarseCandidate> candidates;
-  std::vector<match::RefineResult> refined;
-  for (int attempt = 0;; ++attempt) {
+  std::vector<match::CoarseCandidate> candidates, pass_candidates;
+  std::vector<match::RefineResult> refined, pass_refined;
+  // One pass over all template chunks, unless the candidates outgrow what one binding holds
+  // (many banks at a low threshold): then passes over fewer chunks each, features computed once.
+  const std::size_t chunks = similarity_->chunkCount();
+  std::size_t per_pass = chunks;
+  bool features_done = false;
+  for (std::size_t begin = 0, attempt = 0; begin < chunks;) {
+    const std::size_t end = std::min(chunks, begin + per_pass);
     t0 = std::chrono::steady_clock::now();
-    features_->record(batch, frame, layouts_);
-    similarity_->record(batch, *features_);
+    if (!features_done) features_->record(batch, frame, layouts_);
+    similarity_->record(batch, *features_, begin, end);
     batch.submit();
+    features_done = true;
     timings_.gpu_ms += msSince(t0);
-    if (similarity_->read(candidates, refined)) break;
-    if (attempt == 3) throw DeviceError("the candidate list keeps overflowing; raise the match threshold");
+    if (similarity_->read(pass_candidates, pass_refined)) {
+      candidates.insert(candidates.end(), pass_candidates.begin(), pass_candidates.end());
+      refined.insert(refined.end(), pass_refined.begin(), pass_refined.end());
+      begin = end;
+      attempt = 0;
+      ++timings_.passes;
+      continue;
+    }
+    if (similarity_->full()) {
+      if (end - begin == 1)
+        throw DeviceError("one template chunk finds more candidates than a GPU buffer holds; raise the match threshold");
+      per_pass = std::max<std::size_t>(1, (end - begin) / 2);
+    } else if (++attempt == 4) {
+      throw DeviceError("the candidate list keeps overflowing; raise the match threshold");
+    }
   }
   t0 = std::chrono::steady_clock::now();
   timings_.coarse_candidates = candidates.size();

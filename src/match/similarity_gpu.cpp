@@ -75,7 +75,12 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   // every unit of every template is covered.
   const auto& dev = ctx_.device();
   const std::size_t max_bytes = std::min<std::size_t>(dev.max_storage_buffer_range, 64u << 20);
-  std::size_t max_templates = 65535;
+  // A candidate takes 16 bytes (after a 16-byte count) and its result 8: many banks at once can
+  // find more candidates than one binding holds, and then the matcher splits the chunks into
+  // passes, so chunks are kept to 16384 templates for the split to have something to split.
+  max_capacity_ = static_cast<uint32_t>(std::min<std::size_t>((dev.max_storage_buffer_range - 16) / 16, 1u << 30));
+  capacity_ = std::min(capacity_, max_capacity_);
+  std::size_t max_templates = 16384;
   std::size_t units_per_template = 0;
   if (levels > 1) {
     const auto& fl = layouts[0];
@@ -128,7 +133,7 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   }
 }
 
-void Similarity::record(Batch& batch, const FrameFeatures& features) {
+void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t begin, std::size_t end) {
   const std::size_t coarse = layouts_.size() - 1;
   const auto& cl = layouts_[coarse];
   const bool refine = coarse > 0;
@@ -147,7 +152,8 @@ void Similarity::record(Batch& batch, const FrameFeatures& features) {
   }
   const int blocks = (cl.cells_x + match::kRefineWindow - 1) / match::kRefineWindow;
   const auto& fl = layouts_[0];
-  for (const auto& chunk : chunks_) {
+  for (std::size_t c = begin; c < std::min(end, chunks_.size()); ++c) {
+    const Chunk& chunk = chunks_[c];
     const std::size_t words = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands) *
                               static_cast<std::size_t>(grid.words_per_band);
     const CoarsePush push{chunk.first_template, cl.cells_x, cl.cells_y, cl.stride, blocks, capacity_};
@@ -178,8 +184,11 @@ bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vect
   candidates.clear();
   refined.clear();
   bool complete = true;
+  full_ = false;
   if (count > capacity_) {
-    capacity_ = std::max(count + count / 4, capacity_ * 2);
+    full_ = capacity_ == max_capacity_;
+    capacity_ = static_cast<uint32_t>(
+        std::min<uint64_t>(std::max<uint64_t>(count + uint64_t{count} / 4, uint64_t{capacity_} * 2), max_capacity_));
     complete = false;
   }
   if (layouts_.size() > 1) {

@@ -23,12 +23,18 @@ class Similarity {
   void setTemplates(Batch& batch, const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
                     const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts);
 
-  /// Records coarse scoring and refinement of every template chunk.
-  void record(Batch& batch, const FrameFeatures& features);
+  /// Template chunks (each one dispatch group); record() covers a range of them.
+  std::size_t chunkCount() const { return chunks_.size(); }
+
+  /// Records coarse scoring and refinement of the template chunks [begin, end).
+  void record(Batch& batch, const FrameFeatures& features, std::size_t begin, std::size_t end);
 
   /// After the batch's submit: the candidates and refinements. Returns false when the
-  /// candidate list or the unit list overflowed (they grow; run the frame again).
+  /// candidate list or the unit list overflowed (they grow; run the pass again). When the
+  /// candidate list is already as large as one binding allows, full() turns true: the pass
+  /// must cover fewer chunks.
   bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
+  bool full() const { return full_; }
 
  private:
   struct Chunk {
@@ -42,6 +48,8 @@ class Similarity {
   std::vector<LinearMemoryLayout> layouts_;
   FeatureParams feature_params_;
   uint32_t capacity_ = 1u << 16;       // candidate slots
+  uint32_t max_capacity_ = 0;          // candidate slots one binding can hold
+  bool full_ = false;                  // the last pass overflowed max_capacity_
   uint32_t unit_capacity_ = 1u << 16;  // unit slots of one chunk
   uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk
   std::size_t mark_words_ = 0;         // mark words of the largest chunk

@@ -158,7 +158,7 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
     return out;
   }
   if (out.object_pixels < params.min_scene_points) {
-    out.why = fmt::format("{} scene points under the {}-pixel model (at least {} needed): no depth there",
+    out.why = fmt::format("{} of the {} pixels under the model have scene depth near it (at least {} needed)",
                           out.object_pixels, out.mask_pixels, params.min_scene_points);
     return out;
   }

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 #include <octomap/OcTree.h>
+#include <opencv2/imgproc.hpp>
 
 #include "vkpose/error.hpp"
 
@@ -20,6 +21,84 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("verification crop margin must be >= 0 and finite, got {}", params.crop_margin));
   if (!std::isfinite(params.threshold))
     throw InputError(fmt::format("collision rate threshold must be finite, got {}", params.threshold));
+  if (!(params.see_through_tolerance >= 0.f) || !std::isfinite(params.see_through_tolerance))
+    throw InputError(fmt::format("see-through tolerance must be >= 0 metres, got {}", params.see_through_tolerance));
+  if (!(params.max_see_through >= 0.f && params.max_see_through <= 1.f))
+    throw InputError(fmt::format("the largest see-through share must be in [0, 1], got {}", params.max_see_through));
+  if (!(params.silhouette_jump > 0.f) || !std::isfinite(params.silhouette_jump))
+    throw InputError(fmt::format("the silhouette step must be > 0 metres, got {}", params.silhouette_jump));
+  if (!(params.min_silhouette_support >= 0.f && params.min_silhouette_support <= 1.f))
+    throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
+}
+
+float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
+                        float jump) {
+  CV_Assert(scene_depth_m.type() == CV_32FC1);
+  cv::Mat mask = cv::Mat::zeros(scene_depth_m.size(), CV_8UC1);
+  for (const auto& p : model_points) {
+    if (!p.allFinite() || !(p.z() > 0.f)) continue;
+    const Eigen::Vector2f uv = camera.project(p);
+    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    if (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows) mask.at<uint8_t>(v, u) = 255;
+  }
+  // The points are one per rendered pixel of a nearby pose: close the gaps a small move opens.
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  auto depthAt = [&](float x, float y) {
+    const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
+    if (u < 0 || v < 0 || u >= scene_depth_m.cols || v >= scene_depth_m.rows) return 0.f;
+    return scene_depth_m.at<float>(v, u);
+  };
+  std::size_t steps = 0, usable = 0;
+  for (const auto& contour : contours) {
+    const int n = static_cast<int>(contour.size());
+    if (n < 8) continue;
+    for (int i = 0; i < n; ++i) {
+      const cv::Point a = contour[static_cast<std::size_t>((i + n - 2) % n)];
+      const cv::Point b = contour[static_cast<std::size_t>((i + 2) % n)];
+      Eigen::Vector2f normal(static_cast<float>(b.y - a.y), static_cast<float>(a.x - b.x));
+      if (normal.norm() < 1e-3f) continue;
+      normal.normalize();
+      const Eigen::Vector2f c(static_cast<float>(contour[static_cast<std::size_t>(i)].x),
+                              static_cast<float>(contour[static_cast<std::size_t>(i)].y));
+      // Which side is inside: the mask says (the contour's orientation is OpenCV's business).
+      const Eigen::Vector2f probe = c + 2.f * normal;
+      const int pu = static_cast<int>(std::lround(probe.x())), pv = static_cast<int>(std::lround(probe.y()));
+      if (pu >= 0 && pv >= 0 && pu < mask.cols && pv < mask.rows && mask.at<uint8_t>(pv, pu)) normal = -normal;
+      const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
+      const float z_in = depthAt(in.x(), in.y()), z_out = depthAt(out.x(), out.y());
+      if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
+      ++usable;
+      steps += z_out >= z_in + jump;
+    }
+  }
+  return usable ? static_cast<float>(steps) / static_cast<float>(usable) : 0.f;
+}
+
+DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
+                              float tolerance) {
+  CV_Assert(scene_depth_m.type() == CV_32FC1);
+  std::size_t with_depth = 0, seen_through = 0, occluded = 0;
+  for (const auto& p : model_points) {
+    if (!p.allFinite() || !(p.z() > 0.f)) continue;
+    const Eigen::Vector2f uv = camera.project(p);
+    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    if (u < 0 || v < 0 || u >= scene_depth_m.cols || v >= scene_depth_m.rows) continue;
+    const float z = scene_depth_m.at<float>(v, u);
+    if (!(z > 0.f)) continue;
+    ++with_depth;
+    seen_through += z > p.z() + tolerance;
+    occluded += z < p.z() - tolerance;
+  }
+  DepthAgreement a;
+  a.with_depth = with_depth;
+  if (with_depth == 0) return a;
+  const auto n = static_cast<float>(with_depth);
+  a.seen_through = static_cast<float>(seen_through) / n;
+  a.occluded = static_cast<float>(occluded) / n;
+  a.fits = static_cast<float>(with_depth - seen_through - occluded) / n;
+  return a;
 }
 
 VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
