@@ -68,13 +68,6 @@ PointCloud syntheticCrop(const Mesh& mesh, const Camera& camera, const Pose& tru
   return points;
 }
 
-PointCloud transformed(const PointCloud& points, const Pose& pose) {
-  PointCloud out;
-  out.reserve(points.size());
-  for (const auto& p : points) out.push_back(pose.R * p + pose.t);
-  return out;
-}
-
 Pose inverse(const Pose& pose) { return {pose.R.transpose(), -(pose.R.transpose() * pose.t)}; }
 
 Pose perturbed(const Pose& pose, const Eigen::Vector3f& axis, float degrees, const Eigen::Vector3f& shift_m) {

@@ -28,7 +28,6 @@ PointCloud visibleSurface(const Mesh& mesh, const Camera& camera, const Pose& po
 PointCloud syntheticCrop(const Mesh& mesh, const Camera& camera, const Pose& truth, float noise_m,
                          float outlier_share, std::mt19937& rng, float background_m = 0.05f, int margin_px = 15);
 
-PointCloud transformed(const PointCloud& points, const Pose& pose);  ///< R p + t
 Pose inverse(const Pose& pose);
 /// `pose` rotated by `degrees` about `axis` (camera frame, through the object's origin), then
 /// shifted by `shift_m`.

@@ -35,7 +35,7 @@ Pose lookAt(const Eigen::Vector3f& dir, const Eigen::Vector3f& centre, float dis
 /// What stage 6 hands over: the model's visible surface rendered at the initial pose, in the
 /// object frame.
 PointCloud modelSurface(const Mesh& mesh, const Camera& camera, const Pose& initial) {
-  return test::transformed(test::visibleSurface(mesh, camera, initial), test::inverse(initial));
+  return transformed(test::visibleSurface(mesh, camera, initial), test::inverse(initial));
 }
 
 void print(const std::string& what, const RefineResult& r, const Pose& truth) {

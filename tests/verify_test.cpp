@@ -140,7 +140,7 @@ TEST(Verify, RealFrameRanksRefinedPoseAboveShiftedOnes) {
   const PointCloud crop = test::backProjectMm(depth_mm, camera, cv::Rect(366, 216, 80, 111));  // bbox_visib + 10 px
   const PointCloud frame = test::backProjectMm(depth_mm, camera);
   const Pose refined =
-      refinePose(test::transformed(test::visibleSurface(mesh, camera, truth), test::inverse(truth)), crop, truth).pose;
+      refinePose(transformed(test::visibleSurface(mesh, camera, truth), test::inverse(truth)), crop, truth).pose;
 
   const VerifyResult at_truth = verifyPose(test::visibleSurface(mesh, camera, truth), frame);
   const VerifyResult at_refined = verifyPose(test::visibleSurface(mesh, camera, refined), frame);

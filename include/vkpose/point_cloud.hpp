@@ -5,9 +5,19 @@
 
 #include <Eigen/Core>
 
+#include "vkpose/render.hpp"  // Pose
+
 namespace vkpose {
 
 /// Points in metres; the frame (camera or object) is said where a cloud is used.
 using PointCloud = std::vector<Eigen::Vector3f>;
+
+/// R p + t for every point: a cloud moved by a pose (e.g. object frame to camera frame).
+inline PointCloud transformed(const PointCloud& points, const Pose& pose) {
+  PointCloud out;
+  out.reserve(points.size());
+  for (const auto& p : points) out.push_back(pose.R * p + pose.t);
+  return out;
+}
 
 }  // namespace vkpose

@@ -39,13 +39,6 @@ Detection hypothesisDetection(const Hypothesis& h, const std::vector<TemplateBan
   return d;
 }
 
-PointCloud transformed(const PointCloud& object_points, const Pose& pose) {
-  PointCloud out;
-  out.reserve(object_points.size());
-  for (const auto& p : object_points) out.push_back(pose.R * p + pose.t);
-  return out;
-}
-
 /// The image box and centre of the posed visible model.
 void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vector3f& centre, const Camera& camera) {
   cv::Rect2f box;
