@@ -105,9 +105,13 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
     if (!opt->report.empty()) outputs.push_back(opt->report);
     if (!opt->out.empty())
       for (EvalMethod m : params.methods) outputs.push_back(methodResultsPath(opt->out, m));
-    for (const auto& path : outputs)
+    for (const auto& path : outputs) {
       if (!opt->force && std::filesystem::exists(path))
         throw InputError(path + " exists: pass --force to overwrite it");
+      const auto folder = std::filesystem::path(path).parent_path();
+      if (!folder.empty() && !std::filesystem::is_directory(folder))
+        throw InputError(fmt::format("{}: no such folder to write {} into", folder.string(), path));
+    }
     if (!std::filesystem::is_directory(opt->dataset))
       throw InputError(opt->dataset + ": no such dataset folder");
 
