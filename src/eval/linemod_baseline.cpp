@@ -1,8 +1,6 @@
 // The LINEMOD baseline: raw matches as detections, each with its template's pose.
 #include <chrono>
 
-#include <fmt/format.h>
-
 #include "util/timing.hpp"
 #include "vkpose/baselines.hpp"
 #include "vkpose/error.hpp"
@@ -22,14 +20,7 @@ LinemodBaseline::LinemodBaseline(GpuContext& ctx, std::vector<TemplateBank> bank
 LinemodBaseline::~LinemodBaseline() = default;
 
 DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera& frame_camera) {
-  validateFrame(frame, banks_.front().params.features);
-  Camera camera = frame_camera;
-  camera.width = frame.depth_mm.cols;
-  camera.height = frame.depth_mm.rows;
-  validateCamera(camera);
-  if (camera.cx < 0 || camera.cy < 0 || camera.cx > camera.width || camera.cy > camera.height)
-    throw InputError(fmt::format("the principal point ({}, {}) lies outside the {}x{} frame: wrong camera file?",
-                                 camera.cx, camera.cy, camera.width, camera.height));
+  const Camera camera = frameCamera(frame, frame_camera, banks_.front().params.features);
 
   DetectionResult result;
   const auto total0 = std::chrono::steady_clock::now();
