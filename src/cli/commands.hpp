@@ -31,6 +31,7 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global);
 Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global);
 Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
+Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 

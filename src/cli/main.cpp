@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add(addTrainCommand);
   add(addDetectCommand);
   add(addSynthCommand);
+  add(addEvalCommand);
   add(addBenchCommand);
   add(addDemoCommand);
 

@@ -99,8 +99,8 @@ Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate&
   return poseAtRange(viewingRayRotation(h.x, h.y, camera) * t.pose.R, h.x, h.y, range, bank.centre, camera);
 }
 
-DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_camera) {
-  validateFrame(frame, banks_.front().params.features);
+Camera frameCamera(const LinemodFrame& frame, const Camera& frame_camera, const FeatureParams& features) {
+  validateFrame(frame, features);
   // scene_camera.json entries carry no image size: the frame's is the one that counts. A
   // principal point outside the frame means the intrinsics are for another camera.
   Camera camera = frame_camera;
@@ -110,6 +110,11 @@ DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_
   if (camera.cx < 0 || camera.cy < 0 || camera.cx > camera.width || camera.cy > camera.height)
     throw InputError(fmt::format("the principal point ({}, {}) lies outside the {}x{} frame: wrong camera file?",
                                  camera.cx, camera.cy, camera.width, camera.height));
+  return camera;
+}
+
+DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_camera) {
+  const Camera camera = frameCamera(frame, frame_camera, banks_.front().params.features);
   if (cv::countNonZero(frame.depth_mm) == 0) throw InputError("the depth image is all zero: nothing to detect");
 
   DetectionResult result;

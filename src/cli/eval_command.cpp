@@ -1,0 +1,148 @@
+// `vkpose eval --dataset DIR --bank OBJ_ID=BANK ...`: vkpose and the paper's baselines (LINEMOD
+// alone, Drost et al.'s PPF) on the same images of a BOP dataset, scored with the paper's
+// protocol; prints a table, writes a JSON report and BOP results CSVs.
+#include <filesystem>
+#include <map>
+
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
+#include "vkpose/detection_io.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+
+namespace vkpose::cli {
+
+namespace {
+struct EvalOptions {
+  std::string dataset, split = "test", out, report;
+  std::vector<std::string> banks, methods;
+  bool force = false;
+  EvalRunParams params;
+};
+
+/// "OBJ_ID=BANK" pairs -> obj_id -> bank path.
+std::map<int, std::string> parseBankArgs(const std::vector<std::string>& args) {
+  std::map<int, std::string> out;
+  for (const auto& a : args) {
+    const auto eq = a.find('=');
+    int id = -1;
+    try {
+      std::size_t used = 0;
+      if (eq != std::string::npos) id = std::stoi(a.substr(0, eq), &used);
+      if (used != eq) id = -1;
+    } catch (const std::exception&) {
+      id = -1;
+    }
+    if (id < 0 || eq + 1 >= a.size())
+      throw InputError(fmt::format("--bank {}: expected OBJ_ID=BANK, e.g. --bank 5=can.vkpb (OBJ_ID: the BOP "
+                                   "object id)",
+                                   a));
+    if (!out.emplace(id, a.substr(eq + 1)).second) throw InputError(fmt::format("--bank: object {} given twice", id));
+  }
+  return out;
+}
+}  // namespace
+
+Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<EvalOptions>();
+  auto& p = opt->params;
+  auto* sub = app.add_subcommand(
+      "eval", "Score vkpose and the paper's baselines (linemod, ppf) side by side on a BOP dataset");
+  sub->add_option("--dataset", opt->dataset, "BOP dataset folder (camera.json, models/, SPLIT/SCENE/...)")->required();
+  sub->add_option("--split", opt->split, "Split folder of the dataset")->capture_default_str();
+  sub->add_option("--bank", opt->banks,
+                  "OBJ_ID=BANK: the template bank (.vkpb) of BOP object OBJ_ID; repeat for several objects. The "
+                  "evaluated objects are these");
+  sub->add_option("--method", opt->methods, "Method to run: vkpose, linemod or ppf; repeat (default: all three)");
+  sub->add_option("--out", opt->out,
+                  "BOP results CSV, one per method: METHOD_ is put before the file name (--out r/lmo-test.csv writes "
+                  "r/vkpose_lmo-test.csv, ...)");
+  sub->add_option("--report", opt->report, "JSON report to write (per method: average and per-object scores)");
+  sub->add_option("--images", p.max_images, "Evaluate the first N images only (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
+  auto* protocol = "Evaluation protocol";
+  sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
+      ->check(CLI::Range(0.001, 10.0))
+      ->capture_default_str()
+      ->group(protocol);
+  sub->add_option("--min-visib", p.eval.min_visib_fract,
+                  "Instances less visible than this (visib_fract) are neither missed nor found")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(protocol);
+  auto* methods = "Method parameters";
+  sub->add_option("--threshold", p.detector.match.threshold,
+                  "LINEMOD similarity a match needs, percent (vkpose and linemod)")
+      ->check(CLI::Range(1.0, 100.0))
+      ->capture_default_str()
+      ->group(methods);
+  sub->add_option("--ppf-poses", p.ppf.max_poses, "ppf: poses reported per object and image")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str()
+      ->group(methods);
+  sub->add_option("--ppf-model-step", p.ppf.model_step,
+                  "ppf: model sampling step, fraction of the diameter (finer trains much slower)")
+      ->check(CLI::Range(0.02, 0.5))
+      ->capture_default_str()
+      ->group(methods);
+  sub->add_option("--ppf-scene-step", p.ppf.scene_step, "ppf: scene sampling step, fraction of the diameter")
+      ->check(CLI::Range(0.02, 1.0))
+      ->capture_default_str()
+      ->group(methods);
+  return [opt, &global]() {
+    EvalRunParams params = opt->params;
+    params.linemod.match = params.detector.match;
+    if (!opt->methods.empty()) {
+      params.methods.clear();
+      for (const auto& m : opt->methods) params.methods.push_back(parseEvalMethod(m));
+    }
+    // Nothing is computed before every output is known to be writable.
+    std::vector<std::string> outputs;
+    if (!opt->report.empty()) outputs.push_back(opt->report);
+    if (!opt->out.empty())
+      for (EvalMethod m : params.methods) outputs.push_back(methodResultsPath(opt->out, m));
+    for (const auto& path : outputs) {
+      if (!opt->force && std::filesystem::exists(path))
+        throw InputError(path + " exists: pass --force to overwrite it");
+      const auto folder = std::filesystem::path(path).parent_path();
+      if (!folder.empty() && !std::filesystem::is_directory(folder))
+        throw InputError(fmt::format("{}: no such folder to write {} into", folder.string(), path));
+    }
+    if (!std::filesystem::is_directory(opt->dataset))
+      throw InputError(opt->dataset + ": no such dataset folder");
+
+    const BopDataset dataset = loadBopDataset(opt->dataset, opt->split);
+    std::map<int, TemplateBank> banks;
+    for (const auto& [obj_id, path] : parseBankArgs(opt->banks)) banks.emplace(obj_id, loadBank(path));
+    checkBanksAgainstDataset(banks, dataset);
+
+    GpuContext ctx(global.gpu());
+    ProgressBar bar("evaluating", global.quiet);
+    const EvalReport report =
+        runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
+    bar.finish();
+    for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
+
+    fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
+               report.images == 1 ? "" : "s", report.dataset, report.split, report.objects.size(),
+               report.objects.size() == 1 ? "" : "s", params.eval.k_m, report.device);
+    fmt::print("{}", evalReportTable(report));
+    if (!opt->report.empty()) {
+      writeTextFile(opt->report, evalReportJson(report), opt->force);
+      if (!global.quiet) fmt::print("wrote {}\n", opt->report);
+    }
+    if (!opt->out.empty())
+      for (const MethodEvaluation& m : report.methods) {
+        const std::string path = methodResultsPath(opt->out, m.method);
+        saveBopResults(path, m.results);
+        if (!global.quiet) fmt::print("wrote {} ({} estimates)\n", path, m.results.size());
+      }
+    return kOk;
+  };
+}
+
+}  // namespace vkpose::cli

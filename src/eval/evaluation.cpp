@@ -1,0 +1,215 @@
+// Methods side by side on a BOP dataset: run, time, score, report.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "util/timing.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/frame_io.hpp"
+
+namespace vkpose {
+
+namespace {
+using util::msSince;
+
+PoseEstimate estimateOf(int obj_id, float score, const Pose& pose) { return {obj_id, score, pose.R, pose.t}; }
+
+/// One method's state over the run: the estimator and what it has counted so far.
+struct MethodRun {
+  EvalMethod method;
+  std::map<int, EvalCounts> counts;
+  double total_ms = 0;
+  std::map<int, double> object_ms;
+  std::vector<BopResult> results;
+};
+}  // namespace
+
+std::string methodName(EvalMethod method) {
+  switch (method) {
+    case EvalMethod::Vkpose: return "vkpose";
+    case EvalMethod::Linemod: return "linemod";
+    case EvalMethod::Ppf: return "ppf";
+  }
+  return "?";
+}
+
+EvalMethod parseEvalMethod(const std::string& name) {
+  for (EvalMethod m : {EvalMethod::Vkpose, EvalMethod::Linemod, EvalMethod::Ppf})
+    if (methodName(m) == name) return m;
+  throw InputError(fmt::format("unknown method '{}': the methods are vkpose, linemod and ppf", name));
+}
+
+std::string methodResultsPath(const std::string& path, EvalMethod method) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (methodName(method) + "_" + p.filename().string())).string();
+}
+
+void checkBanksAgainstDataset(const std::map<int, TemplateBank>& banks, const BopDataset& dataset) {
+  for (const auto& [obj_id, bank] : banks) {
+    const auto it = dataset.models.find(obj_id);
+    if (it == dataset.models.end()) {
+      std::string known;
+      for (const auto& [id, info] : dataset.models) known += (known.empty() ? "" : ", ") + std::to_string(id);
+      throw InputError(fmt::format("bank '{}' is for object {}, which {} does not have (its objects: {})", bank.object,
+                                   obj_id, dataset.root, known));
+    }
+    const float d = it->second.diameter;
+    if (std::abs(bank.diameter / d - 1.f) > 0.1f)
+      throw InputError(fmt::format(
+          "bank '{}' was trained on a mesh {:.4f} m across, but object {} of the dataset is {:.4f} m across: a bank "
+          "of another object, or a mesh read in the wrong units (vkpose train --units)",
+          bank.object, bank.diameter, obj_id, d));
+  }
+}
+
+EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::map<int, TemplateBank>& banks,
+                         const EvalRunParams& params, const EvalProgress& progress) {
+  if (params.methods.empty()) throw InputError("no method to evaluate");
+  const std::set<EvalMethod> unique(params.methods.begin(), params.methods.end());
+  if (unique.size() != params.methods.size()) throw InputError("a method is asked for twice");
+  const bool needs_banks = unique.count(EvalMethod::Vkpose) || unique.count(EvalMethod::Linemod);
+  if (needs_banks && banks.empty())
+    throw InputError("vkpose and linemod need a template bank per object: --bank OBJ_ID=BANK");
+  if (params.max_images < 0) throw InputError("the number of images must be >= 0");
+  checkBanksAgainstDataset(banks, dataset);
+  if (dataset.images.empty()) throw InputError(fmt::format("{} has no annotated {} images", dataset.root, dataset.split));
+
+  EvalReport report;
+  report.dataset = dataset.root;
+  report.split = dataset.split;
+  report.device = ctx.device().name;
+  for (const auto& [obj_id, bank] : banks) report.objects.push_back(obj_id);
+  if (banks.empty())
+    for (const auto& [obj_id, info] : dataset.models) report.objects.push_back(obj_id);
+  const std::set<int> evaluated(report.objects.begin(), report.objects.end());
+  std::map<int, EvalModel> models = loadEvalModels(dataset);
+  std::erase_if(models, [&](const auto& m) { return !evaluated.count(m.first); });
+
+  // The estimators; banks in obj_id order, so bank index b is report.objects[b].
+  std::vector<TemplateBank> bank_list;
+  for (const auto& [obj_id, bank] : banks) bank_list.push_back(bank);
+  std::optional<Detector> detector;
+  std::optional<LinemodBaseline> linemod;
+  std::optional<PpfBaseline> ppf;
+  if (unique.count(EvalMethod::Vkpose)) detector.emplace(ctx, bank_list, params.detector);
+  if (unique.count(EvalMethod::Linemod)) linemod.emplace(ctx, bank_list, params.linemod);
+  if (unique.count(EvalMethod::Ppf)) {
+    ppf.emplace(params.ppf);
+    for (int obj_id : report.objects) ppf->addObject(obj_id, loadMesh(dataset.modelPath(obj_id), MeshUnits::Millimetres));
+  }
+
+  const std::size_t n_images = params.max_images > 0
+                                   ? std::min(dataset.images.size(), static_cast<std::size_t>(params.max_images))
+                                   : dataset.images.size();
+  report.images = static_cast<int>(n_images);
+  std::vector<MethodRun> runs;
+  for (EvalMethod m : params.methods) runs.push_back({m, {}, 0, {}, {}});
+  std::set<std::string> warnings;
+  std::size_t step = 0;
+  for (std::size_t i = 0; i < n_images; ++i) {
+    const BopImage& im = dataset.images[i];
+    const LinemodFrame frame = loadFrame(im.rgb_path, im.depth_path, im.camera.depth_scale);
+    std::vector<GroundTruthPose> gt;
+    for (const auto& g : im.gt)
+      if (evaluated.count(g.obj_id)) gt.push_back(g);
+
+    for (MethodRun& run : runs) {
+      std::vector<PoseEstimate> estimates;
+      const auto t0 = std::chrono::steady_clock::now();
+      double image_ms = 0;
+      if (run.method == EvalMethod::Ppf) {
+        const PpfResult r = ppf->detect(frame.depth_mm, im.camera);
+        image_ms = msSince(t0);
+        for (const auto& d : r.detections) estimates.push_back(estimateOf(d.obj_id, d.score, d.pose));
+        for (const auto& [obj_id, ms] : r.object_ms) run.object_ms[obj_id] += ms + r.scene_ms;
+      } else {
+        const DetectionResult r =
+            run.method == EvalMethod::Vkpose ? detector->detect(frame, im.camera) : linemod->detect(frame, im.camera);
+        // The first frame uploads the templates: set-up, like training, not per-image work.
+        image_ms = msSince(t0);
+        for (const auto& [stage, ms] : r.timings_ms)
+          if (stage == "upload") image_ms -= ms;
+        warnings.insert(r.warnings.begin(), r.warnings.end());
+        for (const auto& d : r.detections)
+          estimates.push_back(estimateOf(report.objects[static_cast<std::size_t>(d.bank)], d.score, d.pose));
+        for (int obj_id : report.objects) run.object_ms[obj_id] += image_ms;
+      }
+      run.total_ms += image_ms;
+      try {
+        const ImageEvaluation evaluation = evaluateImage(estimates, gt, models, params.eval);
+        for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{} on scene {} image {}: {}", methodName(run.method), im.scene_id, im.image_id,
+                                     e.what()));
+      }
+      for (const auto& e : estimates) run.results.push_back({im.scene_id, im.image_id, e, image_ms / 1e3});
+      if (progress) progress(++step, n_images * runs.size());
+    }
+  }
+
+  for (MethodRun& run : runs) {
+    for (int obj_id : report.objects) run.counts[obj_id];  // objects never seen still count (as zeros)
+    MethodEvaluation m;
+    m.method = run.method;
+    m.summary = summarize(run.counts);
+    m.ms_per_image = run.total_ms / static_cast<double>(n_images);
+    for (const auto& [obj_id, ms] : run.object_ms) m.object_ms_per_image[obj_id] = ms / static_cast<double>(n_images);
+    m.results = std::move(run.results);
+    report.methods.push_back(std::move(m));
+  }
+  report.warnings.assign(warnings.begin(), warnings.end());
+  return report;
+}
+
+std::string evalReportJson(const EvalReport& report) {
+  using nlohmann::json;
+  json methods = json::object();
+  for (const MethodEvaluation& m : report.methods) {
+    json objects = json::object();
+    for (const auto& [obj_id, s] : m.summary.objects) {
+      const auto ms = m.object_ms_per_image.find(obj_id);
+      objects[std::to_string(obj_id)] = {{"precision", s.precision}, {"recall", s.recall},
+                                         {"f1", s.f1},
+                                         {"ms_per_image", ms == m.object_ms_per_image.end() ? 0.0 : ms->second},
+                                         {"tp", s.tp},
+                                         {"fp", s.fp},
+                                         {"fn", s.fn}};
+    }
+    methods[methodName(m.method)] = {
+        {"average",
+         {{"precision", m.summary.mean.precision}, {"recall", m.summary.mean.recall}, {"f1", m.summary.mean.f1},
+          {"ms_per_image", m.ms_per_image}}},
+        {"objects", objects}};
+  }
+  const json doc = {{"methods", methods},
+                    {"dataset", report.dataset},
+                    {"split", report.split},
+                    {"images", report.images},
+                    {"device", report.device}};
+  return doc.dump(2) + "\n";
+}
+
+std::string evalReportTable(const EvalReport& report) {
+  std::string out = fmt::format("{:<8} {:<8} {:>9} {:>7} {:>6} {:>5} {:>5} {:>5} {:>10}\n", "object", "method",
+                                "precision", "recall", "F1", "TP", "FP", "FN", "ms/image");
+  auto row = [&](const std::string& object, const MethodEvaluation& m, const ObjectScores& s, double ms) {
+    out += fmt::format("{:<8} {:<8} {:>9.3f} {:>7.3f} {:>6.3f} {:>5} {:>5} {:>5} {:>10.1f}\n", object,
+                       methodName(m.method), s.precision, s.recall, s.f1, s.tp, s.fp, s.fn, ms);
+  };
+  for (int obj_id : report.objects)
+    for (const MethodEvaluation& m : report.methods) {
+      const auto ms = m.object_ms_per_image.find(obj_id);
+      row(std::to_string(obj_id), m, m.summary.objects.at(obj_id), ms == m.object_ms_per_image.end() ? 0.0 : ms->second);
+    }
+  for (const MethodEvaluation& m : report.methods) row("average", m, m.summary.mean, m.ms_per_image);
+  return out;
+}
+
+}  // namespace vkpose
