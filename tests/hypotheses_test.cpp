@@ -302,8 +302,13 @@ TEST(Detector, RejectsFramesItCannotUse) {
   // A hole where the instance is: no crash, no detection there.
   LinemodFrame holed{s.frame.bgr, s.frame.depth_mm.clone()};
   cv::circle(holed.depth_mm, cv::Point(320, 240), 90, cv::Scalar(0), cv::FILLED);
-  for (const Detection& d : detector.detect(holed, s.camera).detections)
-    EXPECT_GT(std::hypot(d.x - 320.f, d.y - 240.f), 60.f);
+  const DetectionResult r = detector.detect(holed, s.camera);
+  for (const Detection& d : r.detections) EXPECT_GT(std::hypot(d.x - 320.f, d.y - 240.f), 60.f);
+  // Hypotheses that reached the pose stages there are rejected with a reason, not crashed on.
+  for (const Detection& d : r.rejected) {
+    EXPECT_FALSE(d.verified);
+    EXPECT_FALSE(d.rejection.empty());
+  }
 }
 
 }  // namespace
