@@ -41,9 +41,11 @@ void validateViewSampling(const ViewSamplingParams& p) {
     throw InputError(fmt::format("views: {} viewpoints; use 1 to 100000", p.viewpoints));
   for (float r : p.radii.values())
     if (!(r >= 0.05f && r <= 6.f)) throw InputError(fmt::format("radii: {} m is outside 0.05 to 6 m", r));
+  // Up to a full turn either way, so that a range can be centred on 180 degrees (120:240:10)
+  // for a mesh modelled upside down, whose "up" then points down in the image.
   for (float a : p.inplane_deg.values())
-    if (!(a >= -180.f && a <= 180.f))
-      throw InputError(fmt::format("in-plane rotation {} degrees is outside -180 to 180", a));
+    if (!(a >= -360.f && a <= 360.f))
+      throw InputError(fmt::format("in-plane rotation {} degrees is outside -360 to 360", a));
 }
 
 std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere) {
