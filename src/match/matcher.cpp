@@ -50,14 +50,12 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
   // (many banks at a low threshold): then passes over fewer chunks each, features computed once.
   const std::size_t chunks = similarity_->chunkCount();
   std::size_t per_pass = chunks;
-  bool features_done = false;
+  features_->record(batch, frame, layouts_);  // submitted with the first pass, kept on the device
   for (std::size_t begin = 0, attempt = 0; begin < chunks;) {
     const std::size_t end = std::min(chunks, begin + per_pass);
     t0 = std::chrono::steady_clock::now();
-    if (!features_done) features_->record(batch, frame, layouts_);
     similarity_->record(batch, *features_, begin, end);
     batch.submit();
-    features_done = true;
     timings_.gpu_ms += msSince(t0);
     if (similarity_->read(pass_candidates, pass_refined)) {
       candidates.insert(candidates.end(), pass_candidates.begin(), pass_candidates.end());

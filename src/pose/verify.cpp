@@ -31,6 +31,15 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
 }
 
+namespace {
+/// The scene depth at the pixel nearest to (x, y); 0 outside the image or where there is none.
+float depthAt(const cv::Mat& depth_m, float x, float y) {
+  const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
+  if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) return 0.f;
+  return depth_m.at<float>(v, u);
+}
+}  // namespace
+
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
                         float jump) {
   CV_Assert(scene_depth_m.type() == CV_32FC1);
@@ -45,11 +54,6 @@ float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_dep
   cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  auto depthAt = [&](float x, float y) {
-    const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
-    if (u < 0 || v < 0 || u >= scene_depth_m.cols || v >= scene_depth_m.rows) return 0.f;
-    return scene_depth_m.at<float>(v, u);
-  };
   std::size_t steps = 0, usable = 0;
   for (const auto& contour : contours) {
     const int n = static_cast<int>(contour.size());
@@ -67,7 +71,7 @@ float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_dep
       const int pu = static_cast<int>(std::lround(probe.x())), pv = static_cast<int>(std::lround(probe.y()));
       if (pu >= 0 && pv >= 0 && pu < mask.cols && pv < mask.rows && mask.at<uint8_t>(pv, pu)) normal = -normal;
       const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-      const float z_in = depthAt(in.x(), in.y()), z_out = depthAt(out.x(), out.y());
+      const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
       if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
       ++usable;
       steps += z_out >= z_in + jump;
@@ -83,9 +87,7 @@ DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& sce
   for (const auto& p : model_points) {
     if (!p.allFinite() || !(p.z() > 0.f)) continue;
     const Eigen::Vector2f uv = camera.project(p);
-    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
-    if (u < 0 || v < 0 || u >= scene_depth_m.cols || v >= scene_depth_m.rows) continue;
-    const float z = scene_depth_m.at<float>(v, u);
+    const float z = depthAt(scene_depth_m, uv.x(), uv.y());
     if (!(z > 0.f)) continue;
     ++with_depth;
     seen_through += z > p.z() + tolerance;
