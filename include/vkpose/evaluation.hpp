@@ -28,6 +28,8 @@ struct EvalRunParams {
   PpfParams ppf;
   EvalParams eval;
   int max_images = 0;  ///< the first N images of the split; 0: all
+  /// Called with vkpose's result on each image (e.g. to write its overlay and JSON).
+  std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> on_detections;
 };
 
 /// One method's scores and times.

@@ -41,8 +41,10 @@ struct MeshLoadReport {
 /// unreadable, has no triangles, or has NaN/infinite vertices or a zero-size extent.
 Mesh loadMesh(const std::string& path, MeshUnits units = MeshUnits::Auto, MeshLoadReport* report = nullptr);
 
-/// Fills diameter (exact), centroid, bounding box and, if missing, area-weighted vertex
-/// normals. For meshes built in code. Throws InputError on an empty or non-finite mesh.
+/// Fills diameter (exact), centroid and bounding box, and makes the normals unit length. It
+/// does not invent missing normals: a mesh without them (an STL) renders with flat face
+/// normals, which is what a facetted file means. Throws InputError on an empty or non-finite
+/// mesh.
 void finishMesh(Mesh& mesh);
 
 /// Exact largest distance between two points: candidates are pruned with a lower bound from

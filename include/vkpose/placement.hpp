@@ -67,6 +67,9 @@ struct PlacementParams {
   float drop_step_m = 0.002f;    ///< bin: height step of the drop-and-settle search
   float bin_max_tilt_deg = 35.f; ///< bin: resting orientations tipped by up to this much
   float max_pile_m = 0.2f;       ///< bin: an object whose bottom settles higher than this is left out
+  /// Only the resting orientation the mesh is modelled in (+z up), when it is stable: parts
+  /// that were stacked standing (a tray of cups) rather than tipped out of a box.
+  bool upright_only = false;
 };
 
 /// Where the camera may be: height of its centre above the table and tilt of its optical axis

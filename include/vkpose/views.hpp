@@ -53,4 +53,10 @@ TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f&
 /// All views, viewpoint-major, then radius, then in-plane rotation.
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre);
 
+/// The views whose camera sits within `max_polar_deg` of the object's +z axis, seen from
+/// `centre`: for objects that only ever stand upright under a camera looking down, the rest
+/// of the hemisphere is templates that can only match wrongly.
+std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
+                                     float max_polar_deg);
+
 }  // namespace vkpose

@@ -137,6 +137,7 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
         for (const auto& [stage, ms] : r.timings_ms)
           if (stage == "upload") image_ms -= ms;
         warnings.insert(r.warnings.begin(), r.warnings.end());
+        if (run.method == EvalMethod::Vkpose && params.on_detections) params.on_detections(im, frame, r);
         for (const auto& d : r.detections)
           estimates.push_back(estimateOf(report.objects[static_cast<std::size_t>(d.bank)], d.score, d.pose));
         for (int obj_id : report.objects) run.object_ms[obj_id] += image_ms;

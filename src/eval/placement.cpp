@@ -234,7 +234,13 @@ std::vector<std::optional<Pose>> placeObjects(const std::vector<const Mesh*>& me
   std::vector<std::optional<Pose>> out;
   for (const Mesh* mesh : meshes) {
     if (!mesh) throw InputError("placeObjects: a mesh is missing");
-    const std::vector<RestingOrientation> rest = restingOrientations(*mesh);
+    std::vector<RestingOrientation> rest = restingOrientations(*mesh);
+    if (params.upright_only) {
+      std::vector<RestingOrientation> upright;
+      for (const auto& r : rest)
+        if (r.R(2, 2) > 0.999f) upright.push_back(r);
+      if (!upright.empty()) rest = std::move(upright);
+    }
     std::optional<Pose> found;
     for (int t = 0; t < params.tries && !found; ++t) {
       std::optional<Pose> p = params.layout == Layout::Table

@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 constexpr float kPi = std::numbers::pi_v<float>;
 
-/// Object albedos (RGB), one per obj_id in turn: the shared meshes have no colours.
+/// Albedos (RGB) for meshes without colours, one per obj_id in turn (the shared STLs have none).
 const Eigen::Vector3f kAlbedos[] = {{0.86f, 0.85f, 0.80f}, {0.95f, 0.55f, 0.15f}, {0.25f, 0.45f, 0.80f},
                                     {0.80f, 0.22f, 0.20f}, {0.30f, 0.65f, 0.35f}, {0.78f, 0.72f, 0.30f}};
 
@@ -325,7 +325,8 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
   for (std::size_t i = 0; i < p.meshes.size(); ++i) {
     MeshLoadReport report;
     Mesh m = loadMesh(p.meshes[i], p.units, &report);
-    m.colours.assign(m.vertices.size(), kAlbedos[i % std::size(kAlbedos)]);  // rendered as albedo, lit later
+    // A mesh's own colours are its albedo; an uncoloured one (an STL) gets one of kAlbedos.
+    if (m.colours.size() != m.vertices.size()) m.colours.assign(m.vertices.size(), kAlbedos[i % std::size(kAlbedos)]);
     models.push_back(std::move(m));
     summary.mesh_reports.push_back(report);
   }

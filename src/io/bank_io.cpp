@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "vkpose/bank_cache.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/template_bank.hpp"
 
@@ -137,14 +138,7 @@ Mesh readMesh(Reader& r, const std::string& name) {
   return mesh;
 }
 
-void writePayload(Writer& w, const TemplateBank& bank) {
-  w.putString(bank.object);
-  w.put(bank.mesh_hash);
-  w.put(bank.diameter);
-  w.put(static_cast<uint8_t>(bank.symmetric));
-  for (int i = 0; i < 3; ++i) w.put(bank.centre[i]);
-  writeMesh(w, bank.mesh);
-  const TrainingParams& p = bank.params;
+void writeParams(Writer& w, const TrainingParams& p) {
   w.put(static_cast<int32_t>(p.views.viewpoints));
   w.put(static_cast<uint8_t>(p.views.full_sphere));
   writeRange(w, p.views.radii);
@@ -161,6 +155,16 @@ void writePayload(Writer& w, const TemplateBank& bank) {
   for (double v : {p.camera.fx, p.camera.fy, p.camera.cx, p.camera.cy, p.camera.depth_scale}) w.put(v);
   w.put(static_cast<int32_t>(p.camera.width));
   w.put(static_cast<int32_t>(p.camera.height));
+}
+
+void writePayload(Writer& w, const TemplateBank& bank) {
+  w.putString(bank.object);
+  w.put(bank.mesh_hash);
+  w.put(bank.diameter);
+  w.put(static_cast<uint8_t>(bank.symmetric));
+  for (int i = 0; i < 3; ++i) w.put(bank.centre[i]);
+  writeMesh(w, bank.mesh);
+  writeParams(w, bank.params);
   w.put(static_cast<uint32_t>(bank.templates.size()));
   for (const auto& t : bank.templates) {
     for (int r = 0; r < 3; ++r)
@@ -340,6 +344,25 @@ TemplateBank loadBank(const std::string& path) {
     throw InputError(fmt::format("{}: corrupt template bank (checksum mismatch)", path));
   Reader reader(bytes.data() + kHeaderBytes, payload_bytes, path);
   return readPayload(reader, path);
+}
+
+uint64_t trainingKey(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views) {
+  // Exactly what the bank stores of the mesh and the parameters, plus the views and the file
+  // version: equal keys train equal banks.
+  Writer w;
+  w.put(kBankVersion);
+  writeMesh(w, mesh);
+  writeParams(w, params);
+  w.put(static_cast<uint8_t>(params.symmetric));
+  w.put(static_cast<uint64_t>(views.size()));
+  for (const TrainingView& v : views) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) w.put(v.R(r, c));
+    for (int i = 0; i < 3; ++i) w.put(v.t[i]);
+    w.put(v.distance);
+    w.put(v.inplane_deg);
+  }
+  return fnv1a64(w.bytes.data(), w.bytes.size());
 }
 
 }  // namespace vkpose

@@ -104,4 +104,17 @@ std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Ei
   return views;
 }
 
+std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
+                                     float max_polar_deg) {
+  if (!(max_polar_deg > 0.f && max_polar_deg <= 180.f))
+    throw InputError(fmt::format("the largest angle from the top must be in (0, 180] degrees, not {}", max_polar_deg));
+  const float min_cos = std::cos(max_polar_deg * std::numbers::pi_v<float> / 180.f);
+  std::vector<TrainingView> out;
+  for (const TrainingView& v : views) {
+    const Eigen::Vector3f camera = -(v.R.transpose() * v.t);  // the camera's centre, object frame
+    if ((camera - centre).normalized().z() >= min_cos - 1e-6f) out.push_back(v);
+  }
+  return out;
+}
+
 }  // namespace vkpose
