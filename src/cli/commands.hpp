@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "vkpose/detector.hpp"
 #include "vkpose/gpu_context.hpp"
 
 namespace vkpose::cli {
@@ -32,6 +33,12 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global);
 Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
 Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
+Runner addConfigCommand(CLI::App& app, const GlobalOptions& global);
+/// Adds `--config FILE` (stage parameters, config.hpp) to a command.
+void addConfigOption(CLI::App* sub, std::string& path);
+/// The stage parameters of a command: the config file's (when `path` is not empty), overridden
+/// by the flags that differ from the defaults.
+DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 

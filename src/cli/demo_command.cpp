@@ -13,7 +13,7 @@ namespace vkpose::cli {
 namespace {
 struct DemoOptions {
   DemoParams params;
-  std::string cache = defaultBankCacheDir();
+  std::string cache = defaultBankCacheDir(), config;
   bool no_cache = false;
 };
 
@@ -64,10 +64,12 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
                   "$XDG_CACHE_HOME/vkpose/banks, else ~/.cache/vkpose/banks)")
       ->capture_default_str();
   sub->add_flag("--no-cache", opt->no_cache, "Train the banks again and do not keep them");
+  addConfigOption(sub, opt->config);
   sub->add_flag("--force", p.overwrite, "Replace the demo's outputs in --out even if that folder holds other things");
   return [opt, &global]() {
     DemoParams params = opt->params;
     params.cache_dir = opt->no_cache ? "" : opt->cache;
+    params.detector = withConfig(opt->config, params.detector);
     GpuContext ctx(global.gpu());
     if (!global.quiet) fmt::print("vkpose demo on {} ({})\n", ctx.device().name, ctx.device().type);
     std::unique_ptr<ProgressBar> bar;

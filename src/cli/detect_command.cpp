@@ -18,7 +18,7 @@ namespace vkpose::cli {
 namespace {
 struct DetectOptions {
   std::vector<std::string> banks;
-  std::string rgb, depth, camera, camera_entry, out, overlay;
+  std::string rgb, depth, camera, camera_entry, out, overlay, config;
   OverlayOptions overlay_options;
   double depth_scale = 0;  // 0: the camera file's
   bool force = false;
@@ -47,6 +47,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
                 "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
   sub->add_flag("--force", opt->force, "Overwrite --out and --overlay if they exist");
+  addConfigOption(sub, opt->config);
   auto* stages = "Stage parameters";
   sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
       ->check(CLI::Range(1.0, 100.0))
@@ -108,6 +109,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->group(stages);
   return [opt, &global]() {
+    const DetectorParams params = withConfig(opt->config, opt->params);
     for (const auto* path : {&opt->out, &opt->overlay})
       if (!path->empty() && !opt->force && std::filesystem::exists(*path))
         throw InputError(*path + " exists: pass --force to overwrite it");
@@ -123,14 +125,14 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
     }
     bar.finish();
     GpuContext ctx(global.gpu());
-    Detector detector(ctx, std::move(banks), opt->params);
+    Detector detector(ctx, std::move(banks), params);
     const DetectionResult result = detector.detect(frame, camera);
     for (const auto& w : result.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
     fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
                result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
                result.scored_hypotheses,
-               opt->params.estimate_poses ? opt->params.pose_min_score : opt->params.min_score, ctx.device().name);
+               params.estimate_poses ? params.pose_min_score : params.min_score, ctx.device().name);
     if (!result.rejected.empty())
       fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
                  result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");

@@ -16,7 +16,7 @@ namespace vkpose::cli {
 
 namespace {
 struct EvalOptions {
-  std::string dataset, split = "test", out, report;
+  std::string dataset, split = "test", out, report, config;
   std::vector<std::string> banks, methods;
   bool force = false;
   EvalRunParams params;
@@ -64,6 +64,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
+  addConfigOption(sub, opt->config);
   auto* protocol = "Evaluation protocol";
   sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
       ->check(CLI::Range(0.001, 10.0))
@@ -95,6 +96,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->group(methods);
   return [opt, &global]() {
     EvalRunParams params = opt->params;
+    params.detector = withConfig(opt->config, params.detector);
     params.linemod.match = params.detector.match;
     if (!opt->methods.empty()) {
       params.methods.clear();

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add(addEvalCommand);
   add(addBenchCommand);
   add(addDemoCommand);
+  add(addConfigCommand);
 
   try {
     app.parse(argc, argv);

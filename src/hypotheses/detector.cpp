@@ -79,6 +79,13 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 Detector::~Detector() = default;
 
 void validateDetectorParams(const DetectorParams& p) {
+  if (!(p.match.threshold > 0.f && p.match.threshold <= 100.f))
+    throw InputError(fmt::format("the match threshold must be in (0, 100] percent, not {}", p.match.threshold));
+  if (p.cluster.position_step_px < 1 || p.cluster.min_templates < 1)
+    throw InputError(fmt::format("the clustering cell ({} px) and the smallest cluster ({} templates) must be 1 or more",
+                                 p.cluster.position_step_px, p.cluster.min_templates));
+  if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f))
+    throw InputError("the NMS radius must be 0 or more pixels and its fraction more than 0");
   validateScoreParams(p.score);
   if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
   if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");

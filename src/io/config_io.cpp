@@ -1,0 +1,204 @@
+// Stage parameters in a JSON file (config.hpp).
+#include "vkpose/config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+using nlohmann::json;
+
+std::vector<ConfigField> configFields(DetectorParams& p) {
+  return {
+      {"match", "threshold", "LINEMOD similarity a match needs, percent", &p.match.threshold},
+      {"cluster", "position_step_px", "clustering cell s_im, pixels", &p.cluster.position_step_px},
+      {"cluster", "min_templates", "smallest cluster tau_c, templates", &p.cluster.min_templates},
+      {"score", "depth_unit_m", "alpha = exp(-depth error / unit), metres", &p.score.depth_unit_m},
+      {"score", "depth_cap_m", "per-cell depth errors are truncated here, metres", &p.score.depth_cap_m},
+      {"score", "angle_unit_rad", "beta = exp(-mean normal angle / unit), radians", &p.score.angle_unit_rad},
+      {"score", "normal_step_px", "scene normals from neighbours this far apart, pixels", &p.score.normal_step_px},
+      {"score", "normal_max_jump_m", "neighbours further apart in depth give no normal, metres",
+       &p.score.normal_max_jump_m},
+      {"score", "min_valid_fraction", "share of template cells with scene depth a member needs, 0..1",
+       &p.score.min_valid_fraction},
+      {"score", "max_members", "cluster members scored, at most", &p.score.max_members},
+      {"score", "top_members", "the cluster score is the mean of this many best members", &p.score.top_members},
+      {"nms", "radius_px", "suppression radius, pixels (0: radius_fraction of the object's size)", &p.nms.radius_px},
+      {"nms", "radius_fraction", "suppression radius, share of the larger projected diameter", &p.nms.radius_fraction},
+      {"nms", "across_objects", "suppress across objects too (without poses)", &p.nms.across_objects},
+      {"detector", "estimate_poses", "run stages 6-8 (false: stop after NMS)", &p.estimate_poses},
+      {"detector", "min_score", "without poses: smallest cluster score gamma, 0..1", &p.min_score},
+      {"detector", "pose_min_score", "smallest gamma a hypothesis needs for a pose, 0..1", &p.pose_min_score},
+      {"detector", "pose_candidates_per_object", "hypotheses per object that get a pose", &p.pose_candidates_per_object},
+      {"detector", "duplicate_fraction", "poses closer than this share of the diameter are one, 0..1",
+       &p.duplicate_fraction},
+      {"detector", "threads", "CPU threads for the pose stages (0: all cores)", &p.threads},
+      {"initial_pose", "rotation_cluster_deg", "template rotations within this angle vote together, degrees",
+       &p.initial_pose.rotation_cluster_deg},
+      {"initial_pose", "depth_band_fraction", "scene points within this share of the diameter of the render count",
+       &p.initial_pose.depth_band_fraction},
+      {"initial_pose", "crop_margin_fraction", "scene crop margin, share of the diameter",
+       &p.initial_pose.crop_margin_fraction},
+      {"initial_pose", "min_scene_points", "fewer scene points under the mask: rejected", &p.initial_pose.min_scene_points},
+      {"refine", "mls", "smooth the scene crop with moving least squares", &p.refine.mls},
+      {"refine", "mls_radius", "MLS search radius, metres", &p.refine.mls_radius},
+      {"refine", "mls_polynomial_order", "MLS fit: 2 quadric, 1 plane", &p.refine.mls_polynomial_order},
+      {"refine", "mls_at_voxel_seeds", "MLS only at voxel-grid seeds (faster)", &p.refine.mls_at_voxel_seeds},
+      {"refine", "voxel_size", "ICP voxel grid, metres", &p.refine.voxel_size},
+      {"refine", "coarse_fraction", "coarse ICP correspondence distance, share of the diameter",
+       &p.refine.coarse_fraction},
+      {"refine", "fine_fraction", "fine ICP correspondence distance, share of the diameter", &p.refine.fine_fraction},
+      {"refine", "coarse_iterations", "coarse ICP iteration limit (0: skip)", &p.refine.coarse_iterations},
+      {"refine", "fine_iterations", "fine ICP iteration limit (0: skip)", &p.refine.fine_iterations},
+      {"refine", "convergence_epsilon", "ICP stops when the transform changes less than this",
+       &p.refine.convergence_epsilon},
+      {"refine", "min_points", "fewer points after filtering: rejected", &p.refine.min_points},
+      {"refine", "fixed_max_correspondence_m", "fixed ICP correspondence distance, metres (0: from the diameter)",
+       &p.refine.fixed_max_correspondence_m},
+      {"verify", "resolution", "octree leaf size, metres", &p.verify.resolution},
+      {"verify", "threshold", "collision rate phi a pose needs, 0..1", &p.verify.threshold},
+      {"verify", "crop_margin", "scene points within the model's box grown by this go in the octree, metres",
+       &p.verify.crop_margin},
+      {"verify", "see_through_tolerance", "scene depth this far behind the model sees through it, metres",
+       &p.verify.see_through_tolerance},
+      {"verify", "max_see_through", "largest share of model points the scene may see through, 0..1",
+       &p.verify.max_see_through},
+      {"verify", "silhouette_jump", "a depth step this large marks the outline, metres", &p.verify.silhouette_jump},
+      {"verify", "min_silhouette_support", "share of the outline that must show a depth step, 0..1",
+       &p.verify.min_silhouette_support},
+  };
+}
+
+namespace {
+
+json valueOf(const ConfigField& f) {
+  return std::visit(
+      [](auto* v) -> json {
+        // A float printed shortest and read back as a double: 0.3f is written as 0.3, not
+        // 0.30000001192092896.
+        if constexpr (std::is_same_v<std::remove_pointer_t<decltype(v)>, float>) return std::stod(fmt::format("{}", *v));
+        else return *v;
+      },
+      f.value);
+}
+
+std::string shown(const json& v) {
+  if (v.is_number_float()) return fmt::format("{:g}", v.get<double>());
+  return v.dump();
+}
+
+/// Sets the field from a JSON value of the right kind and range; the error names the key.
+void assign(const ConfigField& f, const json& v, const std::string& where) {
+  const std::string name = fmt::format("{}: {}.{}", where, f.section, f.key);
+  std::visit(
+      [&](auto* field) {
+        using T = std::remove_pointer_t<decltype(field)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          if (!v.is_boolean()) throw InputError(fmt::format("{} must be true or false, not {}", name, v.dump()));
+          *field = v.get<bool>();
+        } else if constexpr (std::is_floating_point_v<T>) {
+          if (!v.is_number()) throw InputError(fmt::format("{} must be a number, not {}", name, v.dump()));
+          const double d = v.get<double>();
+          if (!std::isfinite(d) || std::abs(d) > static_cast<double>(std::numeric_limits<T>::max()))
+            throw InputError(fmt::format("{} must be a finite number, not {}", name, v.dump()));
+          *field = static_cast<T>(d);
+        } else {
+          if (!v.is_number_integer()) throw InputError(fmt::format("{} must be a whole number, not {}", name, v.dump()));
+          if (v.is_number_unsigned()) {
+            const auto u = v.get<uint64_t>();
+            if (u > static_cast<uint64_t>(std::numeric_limits<T>::max()))
+              throw InputError(fmt::format("{} is too large: {}", name, v.dump()));
+            *field = static_cast<T>(u);
+          } else {
+            const auto i = v.get<int64_t>();
+            if (i < static_cast<int64_t>(std::numeric_limits<T>::min()) ||
+                (i > 0 && static_cast<uint64_t>(i) > static_cast<uint64_t>(std::numeric_limits<T>::max())))
+              throw InputError(fmt::format("{} is out of range: {}", name, v.dump()));
+            *field = static_cast<T>(i);
+          }
+        }
+      },
+      f.value);
+}
+
+}  // namespace
+
+std::string configJson(const DetectorParams& params) {
+  DetectorParams p = params;
+  // Sections and keys in pipeline order, as configFields lists them.
+  nlohmann::ordered_json doc = nlohmann::ordered_json::object();
+  for (const ConfigField& f : configFields(p))
+    doc[f.section][f.key] = nlohmann::ordered_json::parse(valueOf(f).dump());
+  return doc.dump(2) + "\n";
+}
+
+std::string configTable(const DetectorParams& params) {
+  DetectorParams p = params;
+  std::string out = fmt::format("{:<42} {:>10}  {}\n", "parameter", "default", "meaning");
+  for (const ConfigField& f : configFields(p))
+    out += fmt::format("{:<42} {:>10}  {}\n", f.section + "." + f.key, shown(valueOf(f)), f.doc);
+  return out;
+}
+
+DetectorParams parseConfig(const std::string& text, const std::string& source, const DetectorParams& base) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(fmt::format("{}: not a JSON config file ({})", source, e.what()));
+  }
+  if (!doc.is_object()) throw InputError(fmt::format("{}: a config file is a JSON object of sections", source));
+  DetectorParams p = base;
+  std::vector<ConfigField> fields = configFields(p);
+  for (const auto& [section, keys] : doc.items()) {
+    if (std::none_of(fields.begin(), fields.end(), [&](const ConfigField& f) { return f.section == section; }))
+      throw InputError(
+          fmt::format("{}: unknown section \"{}\" (see vkpose config --print-defaults)", source, section));
+    if (!keys.is_object())
+      throw InputError(fmt::format("{}: \"{}\" must be an object of parameters", source, section));
+    for (const auto& [key, value] : keys.items()) {
+      const auto it = std::find_if(fields.begin(), fields.end(),
+                                   [&](const ConfigField& f) { return f.section == section && f.key == key; });
+      if (it == fields.end()) {
+        std::string known;
+        for (const ConfigField& f : fields)
+          if (f.section == section) known += (known.empty() ? "" : ", ") + f.key;
+        throw InputError(
+            fmt::format("{}: unknown parameter {}.{} (known in {}: {})", source, section, key, section, known));
+      }
+      assign(*it, value, source);
+    }
+  }
+  try {
+    validateDetectorParams(p);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", source, e.what()));
+  }
+  return p;
+}
+
+DetectorParams loadConfig(const std::string& path, const DetectorParams& base) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: no such config file", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseConfig(text.str(), path, base);
+}
+
+DetectorParams mergeConfig(const DetectorParams& defaults, const DetectorParams& from_file,
+                           const DetectorParams& from_flags) {
+  DetectorParams d = defaults, flags = from_flags, merged = from_file;
+  const auto fd = configFields(d), ff = configFields(flags), fm = configFields(merged);
+  for (std::size_t i = 0; i < fm.size(); ++i)
+    if (valueOf(ff[i]) != valueOf(fd[i])) assign(fm[i], valueOf(ff[i]), "command line");
+  return merged;
+}
+
+}  // namespace vkpose

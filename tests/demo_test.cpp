@@ -1,0 +1,196 @@
+// The demo and what it is made of: procedural meshes, upright placement, views from above,
+// the bank cache, the config file, and the demo end to end on a small template set.
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "test_support.hpp"
+#include "vkpose/bank_cache.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/demo.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/placement.hpp"
+#include "vkpose/procedural_meshes.hpp"
+#include "vkpose/synth.hpp"
+
+using namespace vkpose;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path freshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("vkpose_{}_{}", name, ::getpid());
+  fs::remove_all(dir);
+  return dir;
+}
+}  // namespace
+
+TEST(ProceduralMeshes, SizesAndOutwardNormals) {
+  const std::vector<Mesh> meshes = demoMeshes();
+  ASSERT_EQ(meshes.size(), 3u);
+  for (const Mesh& m : meshes) {
+    SCOPED_TRACE(m.name);
+    EXPECT_GT(m.diameter, 0.10f);
+    EXPECT_LT(m.diameter, 0.25f);
+    EXPECT_NEAR(m.bbox_min.z(), 0.f, 1e-4f) << "stands on its base at z = 0";
+    ASSERT_EQ(m.normals.size(), m.vertices.size());
+    ASSERT_EQ(m.colours.size(), m.vertices.size());
+    // Each face's winding agrees with its vertices' normals (both point outwards), and the
+    // mesh is closed enough that the signed volume is that of a solid.
+    int agree = 0;
+    double volume = 0;
+    for (const auto& f : m.faces) {
+      const Eigen::Vector3f a = m.vertices[f[0]], b = m.vertices[f[1]], c = m.vertices[f[2]];
+      const Eigen::Vector3f n = (b - a).cross(c - a);
+      agree += n.dot(m.normals[f[0]] + m.normals[f[1]] + m.normals[f[2]]) > 0.f;
+      volume += a.dot(b.cross(c)) / 6.0;
+    }
+    EXPECT_GT(agree, 0.99 * static_cast<double>(m.faces.size()));
+    EXPECT_GT(volume, 1e-4) << "a solid of more than 100 cm^3";
+  }
+}
+
+TEST(ProceduralMeshes, LatheIsClosedAroundItsAxis) {
+  const Mesh cylinder = procedural::lathe({{0.f, 0.f}, {0.05f, 0.f}, {0.05f, 0.1f}, {0.f, 0.1f}}, 64, {1, 1, 1});
+  EXPECT_NEAR(cylinder.diameter, std::hypot(0.1f, 0.1f), 1e-3f);
+  double volume = 0;
+  for (const auto& f : cylinder.faces)
+    volume += cylinder.vertices[f[0]].dot(cylinder.vertices[f[1]].cross(cylinder.vertices[f[2]])) / 6.0;
+  EXPECT_NEAR(volume, M_PI * 0.05 * 0.05 * 0.1, 0.01 * M_PI * 0.05 * 0.05 * 0.1);
+  EXPECT_THROW(procedural::lathe({{0.f, 0.f}}, 64, {1, 1, 1}), InputError);
+}
+
+TEST(DemoPlacement, UprightOnlyKeepsPartsStanding) {
+  const Mesh cup = liddedCupMesh();
+  const std::vector<const Mesh*> meshes(6, &cup);
+  PlacementParams params;
+  params.layout = Layout::Bin;
+  params.upright_only = true;
+  params.bin_max_tilt_deg = 5.f;
+  std::mt19937 rng(3);
+  const auto poses = placeObjects(meshes, binWalls(params), params, tejaniCamera(), randomCamera({}, rng), rng);
+  for (const auto& p : poses) {
+    ASSERT_TRUE(p);
+    EXPECT_GT(p->R(2, 2), std::cos(5.1f * M_PI / 180.f)) << "the cup's +z stays within 5 degrees of up";
+  }
+}
+
+TEST(DemoViews, ViewsAboveKeepOnlyTheCone) {
+  ViewSamplingParams v;
+  v.inplane_deg = {0.f, 0.f, 1.f};
+  v.radii = {0.7f, 0.7f, 0.1f};
+  const auto all = sampleViews(v, Eigen::Vector3f::Zero());
+  const auto above = viewsAbove(all, Eigen::Vector3f::Zero(), 40.f);
+  // A Fibonacci lattice is equal-area: the 40-degree cap holds (1 - cos 40) of the hemisphere.
+  EXPECT_NEAR(static_cast<double>(above.size()) / all.size(), 1.0 - std::cos(40.0 * M_PI / 180.0), 0.03);
+  for (const auto& view : above) {
+    const Eigen::Vector3f camera = -(view.R.transpose() * view.t);
+    EXPECT_GE(camera.normalized().z(), std::cos(40.f * M_PI / 180.f) - 1e-5f);
+  }
+  EXPECT_THROW(viewsAbove(all, Eigen::Vector3f::Zero(), 0.f), InputError);
+}
+
+TEST(BankCache, SecondCallReadsTheBankAndOtherParamsTrainAgain) {
+  const fs::path cache = freshDir("bank_cache");
+  const Mesh mesh = gableCartonMesh();
+  TrainingParams params;
+  params.views = {6, false, {0.7f, 0.7f, 0.1f}, {0.f, 0.f, 10.f}};
+  const auto views = sampleViews(params.views, mesh.bboxCentre());
+  const CachedBank first = loadOrTrainBank(test::context(), mesh, params, views, cache.string());
+  EXPECT_FALSE(first.from_cache);
+  ASSERT_TRUE(fs::exists(first.path));
+  const CachedBank second = loadOrTrainBank(test::context(), mesh, params, views, cache.string());
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_EQ(second.path, first.path);
+  EXPECT_EQ(second.bank.templates.size(), first.bank.templates.size());
+
+  TrainingParams other = params;
+  other.features_per_modality = 40;
+  EXPECT_NE(trainingKey(mesh, other, views), trainingKey(mesh, params, views));
+  EXPECT_NE(trainingKey(liddedCupMesh(), params, views), trainingKey(mesh, params, views));
+
+  // A damaged cache file is trained again and replaced, not an error.
+  { std::ofstream(first.path, std::ios::binary | std::ios::trunc) << "not a bank"; }
+  const CachedBank third = loadOrTrainBank(test::context(), mesh, params, views, cache.string());
+  EXPECT_FALSE(third.from_cache);
+  EXPECT_NO_THROW(loadBank(first.path));
+  fs::remove_all(cache);
+}
+
+TEST(Config, DefaultsRoundTripAndValuesApply) {
+  const DetectorParams defaults;
+  const DetectorParams back = parseConfig(configJson(defaults), "defaults");
+  EXPECT_EQ(configJson(back), configJson(defaults));
+  const DetectorParams p =
+      parseConfig(R"({"match": {"threshold": 85}, "verify": {"threshold": 0.5}, "refine": {"mls": false}})", "t");
+  EXPECT_FLOAT_EQ(p.match.threshold, 85.f);
+  EXPECT_FLOAT_EQ(p.verify.threshold, 0.5f);
+  EXPECT_FALSE(p.refine.mls);
+  EXPECT_EQ(p.cluster.min_templates, defaults.cluster.min_templates) << "what the file leaves out keeps its default";
+  // Flags that differ from the defaults win over the file.
+  DetectorParams flags;
+  flags.cluster.min_templates = 7;
+  const DetectorParams merged = mergeConfig(defaults, p, flags);
+  EXPECT_EQ(merged.cluster.min_templates, 7);
+  EXPECT_FLOAT_EQ(merged.match.threshold, 85.f);
+}
+
+TEST(Config, BadFilesAreClearErrors) {
+  auto message = [](const std::string& text) {
+    try {
+      parseConfig(text, "my.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("{ not json").find("my.json: not a JSON config file"), std::string::npos);
+  EXPECT_NE(message(R"({"match": {"treshold": 85}})").find("unknown parameter match.treshold"), std::string::npos);
+  EXPECT_NE(message(R"({"matching": {}})").find("unknown section \"matching\""), std::string::npos);
+  EXPECT_NE(message(R"({"match": {"threshold": "high"}})").find("must be a number"), std::string::npos);
+  EXPECT_NE(message(R"({"cluster": {"min_templates": 2.5}})").find("must be a whole number"), std::string::npos);
+  EXPECT_NE(message(R"({"refine": {"mls": 1}})").find("must be true or false"), std::string::npos);
+  EXPECT_NE(message(R"({"detector": {"threads": -1}})").find("out of range"), std::string::npos);
+  EXPECT_NE(message(R"({"match": {"threshold": 150}})"), "no error") << "validated like the flags";
+  EXPECT_NE(message("[1, 2]").find("a JSON object"), std::string::npos);
+  EXPECT_THROW(loadConfig("/nonexistent/config.json"), InputError);
+}
+
+TEST(Demo, SolvesBinScenesEndToEnd) {
+  const fs::path out = freshDir("demo");
+  DemoParams params;
+  params.out_dir = out.string();
+  params.images = 2;
+  params.cache_dir = std::string(VKPOSE_TEST_CACHE_DIR) + "/demo";
+  // A quarter of the demo's templates (two distances, 20-degree in-plane steps), to keep the
+  // test's training under a minute.
+  params.views.radii = {0.6f, 0.8f, 0.2f};
+  params.views.inplane_deg = {-180.f, 160.f, 20.f};
+  const DemoReport report = runDemo(test::context(), params);
+  ASSERT_EQ(report.objects.size(), 3u);
+  ASSERT_EQ(report.images.size(), 2u);
+  EXPECT_EQ(report.instances, 12);
+  for (const char* f : {"overlay.png", "detections.json", "report.json", "results_vkpose.csv", "meshes/lidded_cup.ply"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const EvalSummary& s = report.evaluation.methods.front().summary;
+  EXPECT_GE(s.mean.precision, 0.8) << "few false positives";
+  EXPECT_GE(s.mean.recall, 0.4);
+
+  // A second run replaces its own folder and reads every bank from the cache.
+  const DemoReport again = runDemo(test::context(), params);
+  for (const auto& o : again.objects) EXPECT_TRUE(o.bank_from_cache) << o.name;
+  EXPECT_DOUBLE_EQ(again.evaluation.methods.front().summary.mean.f1, s.mean.f1) << "same seed, same result";
+
+  // A folder the demo did not write is not touched without --force.
+  const fs::path mine = freshDir("demo_mine");
+  fs::create_directories(mine);
+  { std::ofstream(mine / "notes.txt") << "mine"; }
+  params.out_dir = mine.string();
+  EXPECT_THROW(runDemo(test::context(), params), InputError);
+  EXPECT_TRUE(fs::exists(mine / "notes.txt"));
+  fs::remove_all(out);
+  fs::remove_all(mine);
+}
