@@ -172,5 +172,36 @@ TEST(DetectionIo, RefusesToOverwriteWithoutForce) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(DetectionIo, SideBySideOverlayShowsTheDepthWithTheSameDrawing) {
+  const cv::Mat bgr(240, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  cv::Mat depth(240, 320, CV_16UC1);
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) depth.at<uint16_t>(y, x) = static_cast<uint16_t>(500 + 2 * x);
+  depth(cv::Rect(290, 0, 30, 30)).setTo(0);  // no depth: black
+  DetectionResult result;
+  Detection d;
+  d.object = "box";
+  d.bbox = cv::Rect2f(150, 100, 60, 60);
+  d.x = 180, d.y = 130;
+  result.detections.push_back(d);
+  OverlayOptions options;
+  options.depth_mm = depth;
+  const cv::Mat both = drawDetections(bgr, result, {}, Camera{}, options);
+  ASSERT_EQ(both.size(), cv::Size(640, 240));
+  EXPECT_EQ(both.at<cv::Vec3b>(10, 320 + 305), cv::Vec3b(0, 0, 0)) << "no depth is black";
+  // Near is red, far is blue (BGR).
+  const cv::Vec3b near = both.at<cv::Vec3b>(200, 320 + 2), far = both.at<cv::Vec3b>(200, 320 + 317);
+  EXPECT_GT(near[2], near[0]);
+  EXPECT_GT(far[0], far[2]);
+  // The colour half is the plain overlay; the box is drawn on both halves at the same place.
+  const cv::Mat plain = drawDetections(bgr, result, {}, Camera{});
+  EXPECT_EQ(cv::norm(both(cv::Rect(0, 0, 320, 240)), plain, cv::NORM_INF), 0.0);
+  const cv::Vec3b box_colour = plain.at<cv::Vec3b>(130, 150);
+  EXPECT_NE(box_colour, cv::Vec3b(67, 67, 67)) << "the box edge is drawn on the colour half";
+  EXPECT_EQ(both.at<cv::Vec3b>(130, 320 + 150), box_colour) << "and on the depth half";
+  options.depth_mm = cv::Mat(10, 10, CV_16UC1, cv::Scalar(1000));
+  EXPECT_THROW(drawDetections(bgr, result, {}, Camera{}, options), InputError);
+}
+
 }  // namespace
 }  // namespace vkpose

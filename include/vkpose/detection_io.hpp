@@ -26,6 +26,10 @@ void writeTextFile(const std::string& path, const std::string& text, bool overwr
 
 struct OverlayOptions {
   bool show_rejected = false;  ///< also draw the hypotheses stages 6-8 rejected, in red
+  bool legend = true;          ///< the counts per object and what the label numbers mean
+  /// When set (16-bit, millimetres, the colour image's size): the depth in false colour with
+  /// the same drawing, to the right of the colour image.
+  cv::Mat depth_mm;
 };
 
 /// The colour image with every detection drawn in its object's colour: for a refined pose the
@@ -34,6 +38,11 @@ struct OverlayOptions {
 /// `camera` are the detector's (the meshes and the intrinsics the poses refer to).
 cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const std::vector<TemplateBank>& banks,
                        const Camera& camera, const OverlayOptions& options = {});
+
+/// drawDetections onto an image of the frame's size that the caller prepared (e.g. a depth
+/// rendering), in place; returns it.
+cv::Mat drawDetectionsOn(cv::Mat image, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                         const Camera& camera, const OverlayOptions& options = {});
 
 /// The outer contours of a mesh projected at `pose`, in pixels (its silhouette; no depth test
 /// is needed for that).

@@ -20,6 +20,7 @@ struct DetectOptions {
   std::vector<std::string> banks;
   std::string rgb, depth, camera, camera_entry, out, overlay, config;
   OverlayOptions overlay_options;
+  bool side_by_side = false;
   double depth_scale = 0;  // 0: the camera file's
   bool force = false;
   DetectorParams params;
@@ -46,6 +47,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                   "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)");
   sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
                 "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
+  sub->add_flag("--side-by-side", opt->side_by_side,
+                "Put the depth image (false colour, with the same drawing) to the right of the colour overlay");
   sub->add_flag("--force", opt->force, "Overwrite --out and --overlay if they exist");
   addConfigOption(sub, opt->config);
   auto* stages = "Stage parameters";
@@ -163,8 +166,9 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       Camera image_camera = camera;  // scene_camera.json entries carry no size: the frame's
       image_camera.width = frame.bgr.cols;
       image_camera.height = frame.bgr.rows;
-      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), image_camera, opt->overlay_options),
-                 opt->force);
+      OverlayOptions overlay = opt->overlay_options;
+      if (opt->side_by_side) overlay.depth_mm = frame.depth_mm;
+      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), image_camera, overlay), opt->force);
       if (!global.quiet) fmt::print("wrote {}\n", opt->overlay);
     }
     return kOk;

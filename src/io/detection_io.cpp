@@ -160,12 +160,52 @@ void drawDetection(cv::Mat& out, const Detection& d, const TemplateBank* bank, c
 }
 }  // namespace
 
+namespace {
+
+/// Depth in false colour (near red, far blue), no depth black, with its range written on it.
+cv::Mat depthPanel(const cv::Mat& depth_mm) {
+  CV_Assert(depth_mm.type() == CV_16UC1);
+  const cv::Mat valid = depth_mm > 0;
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(depth_mm, &lo, &hi, nullptr, nullptr, valid);
+  if (hi <= lo) hi = lo + 1;
+  cv::Mat scaled;
+  depth_mm.convertTo(scaled, CV_8U, -255.0 / (hi - lo), 255.0 * hi / (hi - lo));
+  cv::Mat out;
+  cv::applyColorMap(scaled, out, cv::COLORMAP_TURBO);
+  out.setTo(cv::Scalar(0, 0, 0), ~valid);
+  out.convertTo(out, -1, 0.8, 0);
+  cv::putText(out, fmt::format("depth {:.2f} m (red) to {:.2f} m (blue)", lo / 1000, hi / 1000),
+              cv::Point(6, out.rows - 8), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return out;
+}
+
+}  // namespace
+
 cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const std::vector<TemplateBank>& banks,
                        const Camera& camera, const OverlayOptions& options) {
   CV_Assert(bgr.type() == CV_8UC3);
+  if (!options.depth_mm.empty()) {
+    if (options.depth_mm.size() != bgr.size() || options.depth_mm.type() != CV_16UC1)
+      throw InputError("the overlay's depth panel needs a 16-bit depth image of the colour image's size");
+    // The same drawing on the colour image and on the depth, side by side.
+    OverlayOptions single = options;
+    single.depth_mm = cv::Mat();
+    cv::Mat colour = drawDetections(bgr, result, banks, camera, single), depth;
+    single.legend = false;
+    depth = drawDetectionsOn(depthPanel(options.depth_mm), result, banks, camera, single);
+    cv::Mat both;
+    cv::hconcat(colour, depth, both);
+    return both;
+  }
   cv::Mat out = bgr.clone();
   // Dim the image a little so the drawing stands out.
   out.convertTo(out, -1, 0.75, 0);
+  return drawDetectionsOn(out, result, banks, camera, options);
+}
+
+cv::Mat drawDetectionsOn(cv::Mat out, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                         const Camera& camera, const OverlayOptions& options) {
   auto bankOf = [&](const Detection& d) {
     return d.bank >= 0 && static_cast<std::size_t>(d.bank) < banks.size() ? &banks[static_cast<std::size_t>(d.bank)]
                                                                           : nullptr;
@@ -182,6 +222,7 @@ cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const 
     const Detection& d = result.detections[i];
     drawDetection(out, d, bankOf(d), camera, objectColour(d.bank), labelOf(i + 1, d));
   }
+  if (!options.legend) return out;
   // Legend: detections per object, and what the numbers mean.
   std::map<std::string, std::pair<int, int>> per_object;  // object -> (count, bank)
   for (const Detection& d : result.detections) {
