@@ -16,6 +16,7 @@ namespace {
 struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera;
   int views = 216, features = 63;
+  float max_view_angle = 180.f;
   bool symmetric = false, force = false;
 };
 
@@ -51,6 +52,11 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--hemisphere", opt->hemisphere, "Viewpoints on the upper hemisphere or the full sphere")
       ->check(CLI::IsMember({"upper", "full"}))
       ->capture_default_str();
+  sub->add_option("--max-view-angle", opt->max_view_angle,
+                  "Keep only viewpoints within this angle of the object's +z, degrees (e.g. 40 for parts that stand "
+                  "upright under a camera looking down)")
+      ->check(CLI::Range(1.0, 180.0))
+      ->capture_default_str();
   sub->add_option("--features", opt->features, "Features per modality and pyramid level (LINEMOD: 63)")
       ->check(CLI::Range(4, 4096))
       ->capture_default_str();
@@ -74,9 +80,11 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);
     TrainingTimings timings;
-    const TemplateBank bank =
-        trainTemplates(ctx, mesh, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); },
-                       &timings);
+    const std::vector<TrainingView> views =
+        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle);
+    if (views.empty()) throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", opt->max_view_angle));
+    const TemplateBank bank = trainTemplatesFromViews(
+        ctx, mesh, params, views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);
     bar.finish();
     saveBank(bank, opt->out);
     const auto bytes = std::filesystem::file_size(opt->out);
