@@ -34,5 +34,6 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
 Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+void addBenchSoakCommand(CLI::App& bench, const GlobalOptions& global);  ///< `vkpose bench soak`
 
 }  // namespace vkpose::cli

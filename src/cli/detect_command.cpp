@@ -31,8 +31,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   auto& p = opt->params;
   auto* sub = app.add_subcommand("detect", "Find the objects of one or more template banks in an RGB-D frame");
   sub->add_option("--bank", opt->banks, "Template bank (.vkpb) of an object; repeat for several objects")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();  // a missing bank is bad input (exit 1, loadBank names it), not a usage error
   sub->add_option("--rgb", opt->rgb, "Colour image (PNG/JPEG, 8-bit)")->required();
   sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)")->required();
   sub->add_option("--camera", opt->camera, "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json")
