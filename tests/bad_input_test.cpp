@@ -239,6 +239,14 @@ TEST(BadInputCamera, ImageSizePastTheIntRangeIsAnErrorNotUndefinedBehaviour) {
   expectInputError([&] { loadCamera(neg); }, {"neg.json", "height"});
 }
 
+TEST(BadInputBopJson, BoxPastTheIntRangeIsAnErrorNotUndefinedBehaviour) {
+  // Regression (UBSan, float-cast-overflow): bbox values were cast to int unchecked.
+  const auto path = writeFile("big_gt_info.json", R"({"3": [{"bbox_obj": [1e300, 2, 3, 4], "bbox_visib": [1, 2, 3, 4],)"
+                                                  R"( "px_count_all": 9, "px_count_valid": 9, "px_count_visib": 9,)"
+                                                  R"( "visib_fract": 1.0}]})");
+  expectInputError([&] { loadSceneGtInfo(path); }, {"big_gt_info.json", "bbox_obj", "not a pixel coordinate"});
+}
+
 /// The BOP per-image and per-object JSON readers, by name.
 const std::vector<std::pair<std::string, std::function<void(const std::string&)>>>& bopReaders() {
   static const std::vector<std::pair<std::string, std::function<void(const std::string&)>>> readers = {
