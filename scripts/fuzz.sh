@@ -17,6 +17,8 @@ cmake --preset fuzz >/dev/null || exit 1
 cmake --build --preset fuzz || exit 1
 
 out=build/fuzz
+# Leaks inside third-party libraries (assimp) are suppressed, never ours (tests/lsan.supp).
+export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 mkdir -p "$out/artifacts" "$out/logs"
 status=0
 summary=()
