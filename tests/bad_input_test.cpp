@@ -18,10 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "gpu/batch.hpp"
 #include "gpu/vulkan.hpp"
-#include "match/frame_features_gpu.hpp"
-#include "match/match_geometry.hpp"
 #include "tests/mesh_support.hpp"
 #include "tests/test_support.hpp"
 #include "vkpose/dataset.hpp"
@@ -441,35 +438,6 @@ TEST_F(BadInput, HugeImageThroughTheMatcherWithATinyBank) {
   if (bindable >= (uint64_t{1} << 31)) GTEST_SKIP() << devName << " binds 2 GiB at once: 4000x3000 fits";
   expectInputError([&] { matcher.match(frameOf({4000, 3000}, {4000, 3000})); },
                    {"4000x3000 frame is too large", "scale the frame down to about"});
-}
-
-TEST_F(BadInput, FramesOverTheWorkgroupLimitOfOneDispatchDimensionMatch) {
-  // 2600 x 1950 = 5.07 Mpixels: 79,219 workgroups of 64, more than one dispatch dimension
-  // holds on lavapipe. Regression for "too many workgroups": the labels of the last rows
-  // (past the first 65,535 workgroups) must equal the CPU reference's.
-  auto f = frameOf({2600, 1950}, {2600, 1950});
-  cv::circle(f.bgr, {2300, 1800}, 90, {10, 220, 40}, -1);
-  cv::circle(f.depth_mm, {2300, 1800}, 90, cv::Scalar(650), -1);
-  EXPECT_NO_THROW(matcher.match(f));
-  const FeatureParams params;
-  const auto reference = quantizeFramePyramid(f, params);
-  const std::vector<LinemodTemplate> none;
-  const auto layouts = match::makeLayouts(none, params, f.bgr.cols, f.bgr.rows);
-  gpu::FrameFeatures features(test::context(), params);
-  gpu::Batch batch(test::context());
-  features.record(batch, f, layouts);
-  std::vector<QuantizedLevel> labels;
-  features.downloadLabels(batch, labels);
-  batch.submit();
-  ASSERT_EQ(labels.size(), reference.size());
-  for (std::size_t l = 0; l < labels.size(); ++l)
-    for (int m = 0; m < kModalityCount; ++m) {
-      const cv::Mat& ref = reference[l].labels[m];
-      cv::Mat diff;
-      cv::compare(labels[l].labels[m], ref, diff, cv::CMP_NE);
-      EXPECT_EQ(cv::countNonZero(diff), 0) << "level " << l << " modality " << m;
-      EXPECT_GT(cv::countNonZero(ref.rowRange(ref.rows * 9 / 10, ref.rows)), 0) << "nothing to compare at the end";
-    }
 }
 
 TEST_F(BadInput, DepthAllAtMaximum) {
