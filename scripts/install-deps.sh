@@ -5,7 +5,8 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libvulkan-dev mesa-vulkan-drivers vulkan-tools glslc glslang-tools spirv-tools
+  libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslc glslang-tools spirv-tools
+  clang-14 libclang-rt-14-dev
   libeigen3-dev
   libopencv-dev libopencv-contrib-dev
   libassimp-dev assimp-testmodels

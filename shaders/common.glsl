@@ -39,3 +39,10 @@ int normalOrientationBin(int ddx, int ddy) {
   if (ddx >= 0) return ddy >= 0 ? b : (8 - b) & 7;
   return ddy >= 0 ? 4 - b : 4 + b;
 }
+
+// Index of this invocation in a one-dimensional kernel dispatched as rows of
+// gl_NumWorkGroups.x workgroups (gpu::Batch::dispatchLinear): a 12-Mpixel image needs more
+// workgroups than one dimension of a dispatch may have (65535 on lavapipe). A macro, so that
+// gl_WorkGroupSize is read after the shader has declared its local size.
+#define LINEAR_INVOCATION \
+  int(gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x)

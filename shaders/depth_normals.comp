@@ -8,7 +8,7 @@ layout(std430, binding = 1) writeonly buffer Labels { uint8_t labels[]; };
 layout(push_constant) uniform Push { int width; int height; int distance_threshold; int difference_threshold; } pc;
 const int R = 5;
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
   uint label = 0u;

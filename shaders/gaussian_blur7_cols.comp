@@ -7,7 +7,7 @@ layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height * 3) return;
   int row = pc.width * 3;
   int y = i / row, xc = i - y * row;

@@ -7,7 +7,7 @@ layout(std430, binding = 1) writeonly buffer Dst { uint16_t dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
   for (int ch = 0; ch < 3; ++ch) {

@@ -7,7 +7,7 @@ layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
 layout(push_constant) uniform Push { int src_width; int src_height; int width; int height; } pc;
 const int k[5] = int[](1, 4, 6, 4, 1);
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
   int cols[5];

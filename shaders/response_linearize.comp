@@ -9,7 +9,7 @@ layout(push_constant) uniform Push {
   int width; int height; int T; int pad; int stride; int rows; int modality;
 } pc;
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
   uint s = uint(spread[i]);

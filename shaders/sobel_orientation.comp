@@ -9,7 +9,7 @@ layout(std430, binding = 2) writeonly buffer Mag { int magnitude[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 int px(int y, int x, int ch) { return int(img[(y * pc.width + x) * 3 + ch]); }
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
   int u = clampIndex(y - 1, pc.height), d = clampIndex(y + 1, pc.height);

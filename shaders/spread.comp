@@ -7,7 +7,7 @@ layout(std430, binding = 0) readonly buffer Src { uint8_t rows[]; };
 layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
-  int i = int(gl_GlobalInvocationID.x);
+  int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width;
   uint acc = 0u;

@@ -64,6 +64,22 @@ TEST(GpuParity, FrameFeaturesOnOddSizes) {
   }
 }
 
+TEST(GpuParity, FrameFeaturesPastTheWorkgroupLimitOfOneDispatchDimension) {
+  // Regression: 2600 x 1950 = 5.07 Mpixels needs 79,219 workgroups of 64, more than one
+  // dimension of a dispatch holds on lavapipe (65,535), and was refused with "too many
+  // workgroups" (so was 4000 x 3000); the frame kernels now lay their workgroups out in rows.
+  // A random frame: every part of it, the rows past the first 65,535 workgroups too, has labels.
+  LinemodFrame f;
+  f.bgr.create(1950, 2600, CV_8UC3);
+  cv::randu(f.bgr, 0, 256);
+  f.depth_mm.create(1950, 2600, CV_16UC1);
+  cv::randu(f.depth_mm, 500, 540);
+  expectFeatureParity(f, {}, "2600x1950");
+  LinemodMatcher matcher(test::context());
+  matcher.setTemplates(test::templatesFrom(f, {}, 2));
+  EXPECT_NO_THROW(matcher.match(f));
+}
+
 void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, int template_count, float threshold,
                        int copies = 1) {
   auto templates = test::templatesFrom(frame, params, template_count);

@@ -1,6 +1,7 @@
 #include "tests/test_support.hpp"
 
 #include <filesystem>
+#include <memory>
 #include <random>
 
 #include <unistd.h>
@@ -66,9 +67,49 @@ std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const Feat
   return templates;
 }
 
-GpuContext& context() {
-  static GpuContext ctx;
+namespace {
+
+std::unique_ptr<GpuContext>& sharedContext() {
+  static std::unique_ptr<GpuContext> ctx;
   return ctx;
+}
+
+/// Fails the test during which a Vulkan validation error was reported (the release tests run
+/// with VKPOSE_VALIDATION=1, see tests/CMakeLists.txt); the layer's messages are on stderr.
+class ValidationListener : public ::testing::EmptyTestEventListener {
+  uint32_t before_ = 0;
+  void OnTestStart(const ::testing::TestInfo&) override { before_ = GpuContext::processValidationErrors(); }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    // OnTestEnd runs while the test is still the current one: the failure is recorded on it.
+    if (const uint32_t n = GpuContext::processValidationErrors() - before_; n > 0)
+      ADD_FAILURE() << n << " Vulkan validation error(s) during " << info.test_suite_name() << "." << info.name()
+                    << " (the layer's messages are above)";
+  }
+};
+
+/// Destroys the shared context before the test program ends, so that validation errors of
+/// the tear-down (objects left alive) fail the run too.
+class ContextEnvironment : public ::testing::Environment {
+  void TearDown() override {
+    const uint32_t before = GpuContext::processValidationErrors();
+    sharedContext().reset();
+    if (const uint32_t n = GpuContext::processValidationErrors() - before; n > 0)
+      ADD_FAILURE() << n << " Vulkan validation error(s) while destroying the shared context";
+  }
+};
+
+[[maybe_unused]] const bool kRegistered = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ValidationListener);
+  ::testing::AddGlobalTestEnvironment(new ContextEnvironment);
+  return true;
+}();
+
+}  // namespace
+
+GpuContext& context() {
+  auto& ctx = sharedContext();
+  if (!ctx) ctx = std::make_unique<GpuContext>();
+  return *ctx;
 }
 
 std::string inputErrorOf(const std::function<void()>& f) {

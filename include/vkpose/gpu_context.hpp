@@ -59,6 +59,9 @@ class GpuContext {
   const GpuDeviceInfo& device() const;
   /// Number of validation-layer errors seen so far (0 unless validation is on).
   uint32_t validationErrors() const;
+  /// Validation-layer errors of all contexts of this process so far, those already destroyed
+  /// included (tests fail the test during which this grows).
+  static uint32_t processValidationErrors();
 
   gpu::ContextState& state() const { return *state_; }
 

@@ -16,6 +16,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
   bench->require_subcommand(1);
   addBenchTrainCommand(*bench, global);
+  addBenchSoakCommand(*bench, global);
   auto* match = bench->add_subcommand("match", "LINEMOD matching: vkpose vs OpenCV's cv::linemod, same templates");
   auto options = std::make_shared<bench::MatchBenchOptions>();
   auto json_path = std::make_shared<std::string>();

@@ -41,5 +41,6 @@ void addConfigOption(CLI::App* sub, std::string& path);
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+void addBenchSoakCommand(CLI::App& bench, const GlobalOptions& global);  ///< `vkpose bench soak`
 
 }  // namespace vkpose::cli

@@ -2,6 +2,7 @@
 // this boundary; nlohmann's own exceptions never leave this file.
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -82,6 +83,10 @@ std::vector<double> numbers(const json& obj, const char* key, std::size_t count,
 
 cv::Rect box(const json& obj, const char* key, const std::string& where) {
   const auto b = numbers(obj, key, 4, where);
+  // Checked before the cast: a double past the int range cast to int is undefined.
+  for (const double v : b)
+    if (!(std::abs(v) <= 1e6))
+      throw InputError(fmt::format("{}: field '{}' holds {}, not a pixel coordinate", where, key, v));
   return {static_cast<int>(b[0]), static_cast<int>(b[1]), static_cast<int>(b[2]), static_cast<int>(b[3])};
 }
 

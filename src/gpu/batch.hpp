@@ -33,6 +33,15 @@ class Batch {
                 uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
     dispatchRaw(kernel, buffers, &push, sizeof(Push), gx, gy, gz);
   }
+  /// `groups` workgroups of a one-dimensional kernel that indexes with LINEAR_INVOCATION
+  /// (shaders/common.glsl): laid out as rows of at most maxComputeWorkGroupCount[0] groups, so
+  /// that large images stay within the dispatch limits.
+  template <class Push>
+  void dispatchLinear(const Kernel& kernel, std::initializer_list<BufferView> buffers, const Push& push,
+                      uint32_t groups) {
+    const uint32_t row = std::max<uint32_t>(1, std::min<uint32_t>(groups, ctx_.device().max_workgroup_count[0]));
+    dispatchRaw(kernel, buffers, &push, sizeof(Push), row, (groups + row - 1) / row, 1);
+  }
   /// Like dispatch(), with the workgroup counts read on the device from `args` (3 uints at
   /// byte `offset`).
   void dispatchIndirectRaw(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push,

@@ -27,6 +27,8 @@ class Buffer {
   void* mapped() const { return mapped_; }
 
   /// Makes sure the buffer holds at least `bytes`; reallocates (losing contents) if not.
+  /// InputError when the context's buffers would exceed its memory limit or the allocation
+  /// fails (too many or too large template banks).
   void reserve(const GpuContext& ctx, std::size_t bytes, MemoryKind kind = MemoryKind::DeviceLocal);
 
  private:
@@ -36,6 +38,8 @@ class Buffer {
   vk::DeviceMemory memory_;
   std::size_t bytes_ = 0;
   void* mapped_ = nullptr;
+  ContextState* state_ = nullptr;  ///< whose allocated_bytes this buffer counts in
+  uint64_t allocated_ = 0;         ///< bytes of memory_
 };
 
 /// A range of a buffer bound to one shader binding. Ranges must stay within the device's

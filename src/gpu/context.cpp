@@ -1,4 +1,5 @@
 // Vulkan instance, device choice and compute queue (DESIGN.md "GPU layer").
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -36,6 +37,9 @@ int typeRank(const std::string& type) {
   if (type == "cpu") return 3;
   return 4;
 }
+
+/// Validation errors of every context of this process (tests fail the test that caused one).
+std::atomic<uint32_t> g_process_validation_errors{0};
 
 bool layerAvailable(const char* name) {
   for (const auto& layer : vk::enumerateInstanceLayerProperties())
@@ -117,6 +121,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
                                                    void* user) {
   if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
     static_cast<gpu::ContextState*>(user)->validation_errors++;
+    g_process_validation_errors++;
     std::cerr << "vkpose: Vulkan validation: " << data->pMessage << "\n";
   }
   return VK_FALSE;
@@ -188,6 +193,14 @@ GpuContext::GpuContext(const GpuOptions& options) : state_(std::make_unique<gpu:
     s.physical = physicals[chosen];
     s.info = infos[chosen];
     s.memory = s.physical.getMemoryProperties();
+    s.memory_limit = s.info.device_local_memory;
+    if (const char* env = std::getenv("VKPOSE_GPU_MEMORY_LIMIT_MIB"); env && *env) {
+      char* end = nullptr;
+      const unsigned long long mib = std::strtoull(env, &end, 10);
+      if (*end != '\0' || mib == 0)
+        throw InputError(std::string("VKPOSE_GPU_MEMORY_LIMIT_MIB='") + env + "' is not a positive number of MiB");
+      s.memory_limit = std::min<uint64_t>(s.memory_limit, mib << 20);
+    }
 
     if (validation) {
       s.create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -250,5 +263,6 @@ GpuContext::~GpuContext() {
 
 const GpuDeviceInfo& GpuContext::device() const { return state_->info; }
 uint32_t GpuContext::validationErrors() const { return state_->validation_errors.load(); }
+uint32_t GpuContext::processValidationErrors() { return g_process_validation_errors.load(); }
 
 }  // namespace vkpose

@@ -20,6 +20,10 @@ struct ContextState {
   vk::PhysicalDeviceMemoryProperties memory;
   GpuDeviceInfo info;
   std::atomic<uint32_t> validation_errors{0};
+  /// Bytes of the buffers of this context alive now, and the most they may add up to: the
+  /// largest device-local heap, or VKPOSE_GPU_MEMORY_LIMIT_MIB when set (tests lower it).
+  std::atomic<uint64_t> allocated_bytes{0};
+  uint64_t memory_limit = 0;
   PFN_vkCreateDebugUtilsMessengerEXT create_messenger = nullptr;
   PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
 

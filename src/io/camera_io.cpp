@@ -64,8 +64,14 @@ Camera loadCamera(const std::string& path, const std::string& entry) {
       c.cx = number(j, "cx", path);
       c.cy = number(j, "cy", path);
     }
-    if (j.contains("width")) c.width = static_cast<int>(number(j, "width", path));
-    if (j.contains("height")) c.height = static_cast<int>(number(j, "height", path));
+    // Checked before the cast: a double past the int range cast to int is undefined.
+    const auto pixels = [&](const char* key) {
+      const double v = number(j, key, path);
+      if (!(v >= 1 && v <= 16384)) throw InputError(fmt::format("{}: {} {} is outside 1..16384", path, key, v));
+      return static_cast<int>(v);
+    };
+    if (j.contains("width")) c.width = pixels("width");
+    if (j.contains("height")) c.height = pixels("height");
     if (j.contains("depth_scale")) c.depth_scale = number(j, "depth_scale", path);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: {}", path, e.what()));

@@ -1,6 +1,12 @@
 #include "match/frame_features_gpu.hpp"
 
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "match/match_geometry.hpp"
+#include "vkpose/error.hpp"
 
 namespace vkpose::gpu {
 
@@ -37,6 +43,21 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
   const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
   const auto sizes = match::levelSizes(full.width, full.height, params_.T.size());
   levels_.resize(sizes.size());
+  // The linear memories of a level are bound whole (a storage buffer here, a texel buffer in
+  // the similarity kernels): a frame whose memories exceed what the device binds at once is
+  // refused up front with the size that fits, not by a failing dispatch.
+  const auto& dev = ctx_.device();
+  const uint64_t bindable = std::min<uint64_t>(dev.max_storage_buffer_range, dev.max_texel_buffer_elements);
+  for (std::size_t l = 0; l < layouts.size(); ++l)
+    if (layouts[l].total_bytes() > bindable) {
+      const double scale = std::sqrt(static_cast<double>(bindable) / static_cast<double>(layouts[l].total_bytes()));
+      throw InputError(fmt::format(
+          "a {}x{} frame is too large for {}: its response maps at pyramid level {} take {:.0f} MiB, the device binds "
+          "at most {:.0f} MiB at once; scale the frame down to about {}x{}",
+          full.width, full.height, dev.name, l, static_cast<double>(layouts[l].total_bytes()) / (1 << 20),
+          static_cast<double>(bindable) / (1 << 20), static_cast<int>(full.width * scale * 0.98),
+          static_cast<int>(full.height * scale * 0.98)));
+    }
   for (std::size_t l = 0; l < sizes.size(); ++l) {
     Level& L = levels_[l];
     L.size = sizes[l];
@@ -52,21 +73,21 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
-        batch.dispatch(k.pyr_down, {P.bgr, L.bgr}, push, groups);
+        batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, groups);
       }
       L.blur_rows.reserve(ctx_, n * 3 * 2);
       L.smoothed.reserve(ctx_, n * 3);
       L.raw_bins.reserve(ctx_, n);
       L.magnitude.reserve(ctx_, n * 4);
       L.labels[0].reserve(ctx_, n);
-      batch.dispatch(k.blur_rows, {L.bgr, L.blur_rows}, sp, groups);
-      batch.dispatch(k.blur_cols, {L.blur_rows, L.smoothed}, sp, groupsFor(n * 3, kGroup));
-      batch.dispatch(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, groups);
+      batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, groups);
+      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, groupsFor(n * 3, kGroup));
+      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, groups);
       struct {
         int32_t width, height;
         float threshold_sq;
       } vp{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
-      batch.dispatch(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, groups);
+      batch.dispatchLinear(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, groups);
     }
     if (params_.use_depth) {
       L.labels[1].reserve(ctx_, n);
@@ -77,12 +98,12 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
         batch.upload(depth_, depth.data, n * 2);
         const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
                                  params_.difference_threshold_mm};
-        batch.dispatch(k.normals, {depth_, L.depth_raw}, push, groups);
-        batch.dispatch(k.median, {L.depth_raw, L.labels[1]}, sp, groups);
+        batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, groups);
+        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, groups);
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
-        batch.dispatch(k.downsample, {P.labels[1], L.labels[1]}, push, groups);
+        batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, groups);
       }
     }
 
@@ -102,10 +123,10 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
       const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
-      batch.dispatch(k.spread_rows, {L.labels[m], L.spread_rows}, spush, groups);
-      batch.dispatch(k.spread, {L.spread_rows, L.spread}, spush, groups);
+      batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, groups);
+      batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
-      batch.dispatch(k.linearize, {L.spread, L.memory}, lpush, groups);
+      batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush, groups);
     }
   }
 }

@@ -36,9 +36,22 @@ SteppedRange parseSteppedRange(const std::string& text, const std::string& what)
   return r;
 }
 
+namespace {
+/// Before values(): a range of NaN or of too many steps (a damaged bank's) would make it cast
+/// NaN or a huge count to int (undefined; found by fuzz_bank).
+void checkRange(const SteppedRange& r, const char* what) {
+  if (!std::isfinite(r.from) || !std::isfinite(r.to) || !std::isfinite(r.step) || r.step <= 0.f || r.to < r.from)
+    throw InputError(fmt::format("{} {}:{}:{}: need finite FROM <= TO and STEP > 0", what, r.from, r.to, r.step));
+  if ((static_cast<double>(r.to) - r.from) / r.step > 10000.0)
+    throw InputError(fmt::format("{} {}:{}:{}: more than 10000 values", what, r.from, r.to, r.step));
+}
+}  // namespace
+
 void validateViewSampling(const ViewSamplingParams& p) {
   if (p.viewpoints < 1 || p.viewpoints > 100000)
     throw InputError(fmt::format("views: {} viewpoints; use 1 to 100000", p.viewpoints));
+  checkRange(p.radii, "radii");
+  checkRange(p.inplane_deg, "in-plane rotations");
   for (float r : p.radii.values())
     if (!(r >= 0.05f && r <= 6.f)) throw InputError(fmt::format("radii: {} m is outside 0.05 to 6 m", r));
   // Up to a full turn either way, so that a range can be centred on 180 degrees (120:240:10)

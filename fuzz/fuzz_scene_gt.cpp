@@ -1,0 +1,9 @@
+// libFuzzer target: BOP scene_gt.json (loadSceneGt, src/eval/dataset.cpp).
+#include "fuzz/fuzz_support.hpp"
+#include "vkpose/dataset.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
+  const std::string path = vkpose::fuzz::inputFile(data, size, "scene_gt.json");
+  vkpose::fuzz::expectNoCrash([&] { vkpose::loadSceneGt(path); });
+  return 0;
+}

@@ -1,0 +1,27 @@
+// Training parameters and the bank's template list: what the bank reader needs, apart from
+// the GPU training itself (the fuzz build links the readers without the GPU layer).
+#include <fmt/format.h>
+
+#include "vkpose/error.hpp"
+#include "vkpose/template_bank.hpp"
+
+namespace vkpose {
+
+void validateTrainingParams(const TrainingParams& p) {
+  validateViewSampling(p.views);
+  validateFeatureParams(p.features);
+  validateCamera(p.camera, "training camera");
+  if (p.features_per_modality < 4 || p.features_per_modality > 4096)
+    throw InputError(fmt::format("features: {} per modality; use 4 to 4096", p.features_per_modality));
+  if (!(p.strong_threshold > 0.f && p.strong_threshold < 2000.f))
+    throw InputError(fmt::format("strong threshold {} must be in (0, 2000)", p.strong_threshold));
+}
+
+std::vector<LinemodTemplate> TemplateBank::linemodTemplates() const {
+  std::vector<LinemodTemplate> out;
+  out.reserve(templates.size());
+  for (const auto& t : templates) out.push_back(t.linemod);
+  return out;
+}
+
+}  // namespace vkpose
