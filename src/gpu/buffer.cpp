@@ -1,8 +1,23 @@
 #include "gpu/buffer.hpp"
 
+#include <atomic>
 #include <utility>
 
 namespace vkpose::gpu {
+
+namespace {
+std::atomic<std::size_t> live_bytes{0}, peak_bytes{0};
+
+void countAllocation(std::size_t bytes) {
+  const std::size_t now = live_bytes.fetch_add(bytes) + bytes;
+  for (std::size_t peak = peak_bytes.load(); now > peak && !peak_bytes.compare_exchange_weak(peak, now);) {
+  }
+}
+}  // namespace
+
+BufferMemory bufferMemory() { return {live_bytes.load(), peak_bytes.load()}; }
+
+void resetBufferPeak() { peak_bytes = live_bytes.load(); }
 
 Buffer::Buffer(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) { reserve(ctx, bytes, kind); }
 
@@ -18,6 +33,7 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
     memory_ = std::exchange(o.memory_, {});
     bytes_ = std::exchange(o.bytes_, 0);
     mapped_ = std::exchange(o.mapped_, nullptr);
+    allocated_ = std::exchange(o.allocated_, 0);
   }
   return *this;
 }
@@ -27,6 +43,8 @@ void Buffer::release() {
   if (mapped_) device_.unmapMemory(memory_);
   device_.destroyBuffer(buffer_);
   device_.freeMemory(memory_);
+  live_bytes -= allocated_;
+  allocated_ = 0;
   device_ = vk::Device{};
   buffer_ = vk::Buffer{};
   memory_ = vk::DeviceMemory{};
@@ -53,6 +71,8 @@ void Buffer::reserve(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) 
   memory_ = s.device.allocateMemory({.allocationSize = req.size,
                                      .memoryTypeIndex = s.memoryType(req.memoryTypeBits, flags)});
   s.device.bindBufferMemory(buffer_, memory_, 0);
+  allocated_ = req.size;
+  countAllocation(allocated_);
   if (host) mapped_ = s.device.mapMemory(memory_, 0, VK_WHOLE_SIZE);
   bytes_ = bytes;
 }
