@@ -34,5 +34,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
 Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
 /// `vkpose bench train`, registered under the `bench` subcommand.
 void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+/// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.
+Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global);
 
 }  // namespace vkpose::cli
