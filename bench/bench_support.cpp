@@ -33,7 +33,8 @@ std::size_t statusBytes(const std::string& name) {
 std::size_t residentBytes() { return statusBytes("VmRSS"); }
 
 std::size_t peakResidentBytes() {
-  if (const std::size_t hwm = statusBytes("VmHWM")) return hwm;
+  // The kernel updates VmHWM lazily: it can lag VmRSS by a few pages.
+  if (const std::size_t hwm = statusBytes("VmHWM")) return std::max(hwm, residentBytes());
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kilobytes on Linux

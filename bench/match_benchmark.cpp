@@ -157,7 +157,8 @@ std::vector<MatchBenchRow> runMatchBenchmark(const MatchBenchOptions& o, const G
       row.opencv_matches = theirs.size();
       row.ratio = row.opencv_ms / row.vkpose_ms;
     }
-    row.peak_rss_bytes = peakResidentBytes();
+    // VmHWM lags VmRSS by a few pages: the peak is at least every resident figure seen.
+    row.peak_rss_bytes = std::max({peakResidentBytes(), row.rss_bytes, rows.empty() ? 0 : rows.back().peak_rss_bytes});
     if (o.progress) std::cerr << " done\n";
     rows.push_back(row);
   }

@@ -17,7 +17,8 @@ namespace vkpose::cli {
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
   bench->require_subcommand(1);
-  addBenchTrainCommand(*bench, global);
+  const Runner train = addBenchTrainCommand(*bench, global);
+  auto* train_command = bench->get_subcommand("train");
   const Runner detect = addBenchDetectCommand(*bench, global);
   auto* detect_command = bench->get_subcommand("detect");
   auto* match = bench->add_subcommand("match", "LINEMOD matching: vkpose vs OpenCV's cv::linemod, same templates");
@@ -55,9 +56,9 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
                     "Objects sweep: each object is a copy of this bank's templates (default: templates cut from the "
                     "frame)");
   match->add_option("--json", *json_path, "Write the results as JSON to this file (never overwritten)");
-  return [options, json_path, sweep, templates_option, detect, detect_command, &global, match]() {
+  return [options, json_path, sweep, templates_option, train, train_command, detect, detect_command, &global]() {
+    if (train_command->parsed()) return train();
     if (detect_command->parsed()) return detect();
-    if (!match->parsed()) return 0;  // another bench subcommand ran in its callback
     if (options->rgb.empty() != options->depth.empty()) throw InputError("--rgb and --depth go together");
     if (!json_path->empty() && std::ifstream(*json_path).good())
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");

@@ -32,8 +32,8 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global);
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global);
 Runner addSynthCommand(CLI::App& app, const GlobalOptions& global);
 Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
-/// `vkpose bench train`, registered under the `bench` subcommand.
-void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+/// `vkpose bench train`, registered under the `bench` subcommand; the runner runs it.
+Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 /// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.
 Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global);
 
