@@ -139,6 +139,7 @@ std::vector<MatchBenchRow> runMatchBenchmark(const MatchBenchOptions& o, const G
       row.vkpose_ms = median(times);
       row.vkpose_matches = ours.size();
       row.passes = matcher.lastTimings().passes;
+      row.attempts = matcher.lastTimings().attempts;
       row.coarse_candidates = matcher.lastTimings().coarse_candidates;
       row.gpu_peak_bytes = gpu::bufferMemory().peak;
       row.rss_bytes = residentBytes();

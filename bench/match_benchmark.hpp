@@ -33,7 +33,8 @@ struct MatchBenchRow {
   std::string device;
   double vkpose_ms = 0, opencv_ms = 0, ratio = 0;
   std::size_t vkpose_matches = 0, opencv_matches = 0;
-  std::size_t passes = 0;            ///< similarity submits per frame (MatchTimings::passes)
+  std::size_t passes = 0;            ///< similarity passes per frame (MatchTimings::passes)
+  std::size_t attempts = 0;          ///< similarity submits per frame, overflowed ones included
   std::size_t coarse_candidates = 0;
   std::size_t gpu_peak_bytes = 0;    ///< the most our GPU buffers held at once during this row
   std::size_t rss_bytes = 0;         ///< resident memory after vkpose's runs (templates, matcher)

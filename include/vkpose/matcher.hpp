@@ -46,6 +46,9 @@ struct MatchTimings {
   /// Submits of the similarity stage: 1 unless the candidates outgrew one GPU buffer and
   /// the template chunks were split over several passes.
   std::size_t passes = 0;
+  /// Similarity submits including those that overflowed and were run again (passes when
+  /// none did): each overflow costs a pass's work.
+  std::size_t attempts = 0;
 };
 
 namespace gpu {
@@ -80,6 +83,9 @@ class LinemodMatcher {
   std::unique_ptr<gpu::Similarity> similarity_;
   std::vector<LinearMemoryLayout> layouts_;
   cv::Size uploaded_for_;  ///< frame size the templates were laid out for
+  /// Template chunks per similarity pass that the last frame got through without overflowing
+  /// (0: all); the next frame starts from it instead of failing its way down again.
+  std::size_t chunks_per_pass_ = 0;
   MatchTimings timings_;
 };
 

@@ -93,7 +93,8 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
                  r.objects > 0 ? std::to_string(r.objects) : "-", r.templates, r.vkpose_ms,
                  r.opencv_ms > 0 ? fmt::format("{:.1f}", r.opencv_ms) : "-",
                  r.opencv_ms > 0 ? fmt::format("{:.2f}", r.ratio) : "-", r.vkpose_matches,
-                 r.opencv_ms > 0 ? std::to_string(r.opencv_matches) : "-", r.passes,
+                 r.opencv_ms > 0 ? std::to_string(r.opencv_matches) : "-",
+                 r.attempts > r.passes ? fmt::format("{}/{}", r.passes, r.attempts) : std::to_string(r.passes),
                  bench::formatBytes(r.gpu_peak_bytes), bench::formatBytes(r.rss_bytes),
                  bench::formatBytes(r.peak_rss_bytes));
       nlohmann::json row = {{"templates", r.templates},
@@ -101,6 +102,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
                             {"vkpose_ms", r.vkpose_ms},
                             {"vkpose_matches", r.vkpose_matches},
                             {"passes", r.passes},
+                            {"attempts", r.attempts},
                             {"coarse_candidates", r.coarse_candidates},
                             {"gpu_peak_bytes", r.gpu_peak_bytes},
                             {"rss_bytes", r.rss_bytes},
@@ -113,8 +115,8 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
       }
       out.push_back(row);
     }
-    fmt::print("(GPU peak: our GPU buffers at most at once; RSS: resident after vkpose's runs; peak RSS: the process "
-               "so far)\n");
+    fmt::print("(passes: similarity passes, /submits when some overflowed and ran again; GPU peak: our GPU buffers at "
+               "most at once; RSS: resident after vkpose's runs; peak RSS: the process so far)\n");
     if (!gpu::kernelProfile().empty()) {
       fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS):\n");
       for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
