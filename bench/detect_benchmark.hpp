@@ -61,7 +61,7 @@ struct DetectBenchReport {
   std::vector<std::string> warnings;
 };
 
-/// (phase, done, total) as work goes on: "loading banks", "frames", "detect", "cv::linemod".
+/// (phase, done, total) as work goes on: "loading banks", "warm-up", "detect", "cv::linemod".
 using BenchProgress = std::function<void(const std::string&, std::size_t, std::size_t)>;
 
 /// Throws InputError for no bank, frames < 1, warmup < 0, a bank that cannot be read, or a source whose
