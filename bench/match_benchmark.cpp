@@ -1,33 +1,24 @@
 #include "bench/match_benchmark.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <random>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/bench_support.hpp"
+#include "gpu/buffer.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/frame_io.hpp"
 #include "vkpose/matcher.hpp"
 #include "vkpose/opencv_linemod.hpp"
+#include "vkpose/template_bank.hpp"
 
 namespace vkpose::bench {
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
-template <class F>
-double timeMs(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// A synthetic tabletop frame: boxes and discs at several depths on a plane.
 LinemodFrame syntheticFrame() {
@@ -88,44 +79,76 @@ std::vector<MatchBenchRow> runMatchBenchmark(const MatchBenchOptions& o, const G
   mp.threshold = o.threshold;
   const auto modalities = activeModalities(fp);
 
-  // Base templates cut by OpenCV's own extraction from regions of the frame, then jittered
-  // copies up to the largest count. Both sides get exactly the same templates.
-  const int wanted = *std::max_element(o.template_counts.begin(), o.template_counts.end());
-  std::mt19937 rng(42);
-  std::vector<cv::Rect> regions;
-  std::uniform_int_distribution<int> size(48, 160);
-  for (int i = 0; i < 160; ++i) {
-    const int w = size(rng), h = size(rng);
-    std::uniform_int_distribution<int> x(0, frame.bgr.cols - w), y(0, frame.bgr.rows - h);
-    regions.emplace_back(x(rng), y(rng), w, h);
+  std::vector<int> counts = o.template_counts;
+  if (o.sweep == MatchSweep::Objects) {
+    counts.clear();
+    for (const int n : o.object_counts) counts.push_back(n * o.templates_per_object);
   }
-  auto extractor = makeOpenCvDetector(fp);
-  std::vector<LinemodTemplate> templates = extractOpenCvTemplates(*extractor, frame, regions, fp);
-  if (templates.empty()) throw InputError("no LINEMOD templates could be cut from " + frame_description);
-  const std::size_t base_count = templates.size();
-  while (templates.size() < static_cast<std::size_t>(wanted))
-    templates.push_back(jitter(templates[rng() % base_count], rng));
+  const int wanted = *std::max_element(counts.begin(), counts.end());
+  std::vector<LinemodTemplate> templates;
+  std::vector<int> object_templates;  // the objects sweep: templates per object
+  if (o.sweep == MatchSweep::Objects && !o.bank.empty()) {
+    // Each object a copy of the bank's templates (as if the same object were trained again).
+    const TemplateBank bank = loadBank(o.bank);
+    if (bank.params.features.T != fp.T || bank.params.features.use_colour != fp.use_colour ||
+        bank.params.features.use_depth != fp.use_depth)
+      throw InputError("bank '" + o.bank + "' was trained with another pyramid or other modalities than the benchmark's");
+    const std::vector<LinemodTemplate> one = bank.linemodTemplates();
+    counts.clear();
+    for (const int n : o.object_counts) counts.push_back(n * static_cast<int>(one.size()));
+    const int objects = *std::max_element(o.object_counts.begin(), o.object_counts.end());
+    templates.reserve(one.size() * static_cast<std::size_t>(objects));
+    for (int k = 0; k < objects; ++k) templates.insert(templates.end(), one.begin(), one.end());
+  } else {
+    // Base templates cut by OpenCV's own extraction from regions of the frame, then jittered
+    // copies up to the largest count. Both sides get exactly the same templates.
+    std::mt19937 rng(42);
+    std::vector<cv::Rect> regions;
+    std::uniform_int_distribution<int> size(48, 160);
+    for (int i = 0; i < 160; ++i) {
+      const int w = size(rng), h = size(rng);
+      std::uniform_int_distribution<int> x(0, frame.bgr.cols - w), y(0, frame.bgr.rows - h);
+      regions.emplace_back(x(rng), y(rng), w, h);
+    }
+    auto extractor = makeOpenCvDetector(fp);
+    templates = extractOpenCvTemplates(*extractor, frame, regions, fp);
+    if (templates.empty()) throw InputError("no LINEMOD templates could be cut from " + frame_description);
+    const std::size_t base_count = templates.size();
+    templates.reserve(static_cast<std::size_t>(wanted));
+    while (templates.size() < static_cast<std::size_t>(wanted))
+      templates.push_back(jitter(templates[rng() % base_count], rng));
+  }
 
   GpuContext ctx(gpu_options);
   std::vector<MatchBenchRow> rows;
-  for (int count : o.template_counts) {
+  for (std::size_t c = 0; c < counts.size(); ++c) {
+    const int count = counts[c];
     if (o.progress) std::cerr << "bench match: " << count << " templates ..." << std::flush;
-    std::vector<LinemodTemplate> subset(templates.begin(), templates.begin() + count);
     MatchBenchRow row;
     row.templates = count;
+    row.objects = o.sweep == MatchSweep::Objects ? o.object_counts[c] : 0;
     row.device = ctx.device().name;
 
-    LinemodMatcher matcher(ctx, fp, mp);
-    matcher.setTemplates(subset);
-    std::vector<Match> ours = matcher.match(frame);  // warm-up, uploads templates
     std::vector<double> times;
-    for (int r = 0; r < o.repeats; ++r) times.push_back(timeMs([&] { ours = matcher.match(frame); }));
-    row.vkpose_ms = median(times);
-    row.vkpose_matches = ours.size();
+    {
+      gpu::resetBufferPeak();
+      LinemodMatcher matcher(ctx, fp, mp);
+      matcher.setTemplates({templates.begin(), templates.begin() + count});
+      std::vector<Match> ours = matcher.match(frame);  // warm-up, uploads templates
+      for (int r = 0; r < o.repeats; ++r) times.push_back(timeMs([&] { ours = matcher.match(frame); }));
+      row.vkpose_ms = median(times);
+      row.vkpose_matches = ours.size();
+      row.passes = matcher.lastTimings().passes;
+      row.attempts = matcher.lastTimings().attempts;
+      row.coarse_candidates = matcher.lastTimings().coarse_candidates;
+      row.gpu_peak_bytes = gpu::bufferMemory().peak;
+      row.rss_bytes = residentBytes();
+    }
 
     if (o.run_opencv) {
       auto detector = makeOpenCvDetector(fp);
-      for (const auto& t : subset) detector->addSyntheticTemplate(toOpenCvTemplate(t, modalities), "bench");
+      for (int i = 0; i < count; ++i)
+        detector->addSyntheticTemplate(toOpenCvTemplate(templates[static_cast<std::size_t>(i)], modalities), "bench");
       std::vector<cv::Mat> sources{frame.bgr, frame.depth_mm};
       std::vector<cv::linemod::Match> theirs;
       detector->match(sources, o.threshold, theirs);
@@ -135,10 +158,38 @@ std::vector<MatchBenchRow> runMatchBenchmark(const MatchBenchOptions& o, const G
       row.opencv_matches = theirs.size();
       row.ratio = row.opencv_ms / row.vkpose_ms;
     }
+    // VmHWM lags VmRSS by a few pages: the peak is at least every resident figure seen.
+    row.peak_rss_bytes = std::max({peakResidentBytes(), row.rss_bytes, rows.empty() ? 0 : rows.back().peak_rss_bytes});
     if (o.progress) std::cerr << " done\n";
     rows.push_back(row);
   }
   return rows;
+}
+
+std::vector<int> templateSweepCounts() { return {1000, 3000, 10000, 30000, 100000}; }
+
+std::string matchSweepSvg(const std::vector<MatchBenchRow>& rows, const std::string& frame_description) {
+  const bool objects = !rows.empty() && rows.front().objects > 0;
+  PlotSeries ours{"vkpose", "#1f77b4", {}}, theirs{"cv::linemod", "#d62728", {}};
+  for (const auto& r : rows) {
+    const double x = objects ? r.objects : r.templates;
+    ours.points.emplace_back(x, r.vkpose_ms);
+    if (r.opencv_ms > 0) theirs.points.emplace_back(x, r.opencv_ms);
+  }
+  PlotSpec spec;
+  spec.title = fmt::format("LINEMOD matching, {}", rows.empty() ? "" : rows.front().device);
+  spec.x_label = objects ? fmt::format("objects ({} templates each)", rows.front().templates / rows.front().objects)
+                         : "templates";
+  spec.y_label = "median ms per frame";
+  spec.log_y = true;
+  spec.series.push_back(ours);
+  if (!theirs.points.empty()) spec.series.push_back(theirs);
+  std::string svg = svgLinePlot(spec);
+  // The frame, as a comment: where the numbers came from.
+  std::string what = frame_description;
+  for (std::size_t at; (at = what.find("--")) != std::string::npos;) what.replace(at, 2, "- -");  // not in a comment
+  const std::string comment = "<!-- frame: " + what + " -->\n";
+  return svg.insert(svg.find('\n') + 1, comment);
 }
 
 }  // namespace vkpose::bench

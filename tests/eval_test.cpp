@@ -142,6 +142,7 @@ TEST(LinemodBaseline, ReportsEveryMatchWithAPoseThatProjectsOntoIt) {
   for (bool offset : {false, true}) {
     LinemodBaselineParams params;
     params.depth_offset = offset;
+    params.max_per_object = 0;  // all
     LinemodBaseline baseline(test::context(), {bank}, params);
     const DetectionResult r = baseline.detect(lmo().frame, camera);
     ASSERT_GT(r.detections.size(), 10u) << "offset " << offset;
@@ -166,6 +167,34 @@ TEST(LinemodBaseline, ReportsEveryMatchWithAPoseThatProjectsOntoIt) {
       EXPECT_NEAR((d.pose.R.transpose() * d.pose.R - Eigen::Matrix3f::Identity()).norm(), 0.f, 1e-4f);
     }
   }
+}
+
+TEST(LinemodBaseline, KeepsTheBestMatchesOfEachObject) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const TemplateBank& bank = drillerBank();
+  const Camera& camera = lmo().image().camera;
+  LinemodBaselineParams all;
+  all.depth_offset = false;
+  all.max_per_object = 0;
+  const DetectionResult every = LinemodBaseline(test::context(), {bank}, all).detect(lmo().frame, camera);
+  constexpr int kCap = 7;
+  ASSERT_GT(every.detections.size(), static_cast<std::size_t>(kCap));
+  // The same bank as two objects: each keeps its own best kCap.
+  LinemodBaselineParams capped = all;
+  capped.max_per_object = kCap;
+  const DetectionResult r = LinemodBaseline(test::context(), {bank, bank}, capped).detect(lmo().frame, camera);
+  EXPECT_EQ(r.matches, 2 * every.matches);  // the raw count stays
+  ASSERT_EQ(r.detections.size(), static_cast<std::size_t>(2 * kCap));
+  for (int b = 0; b < 2; ++b) {
+    std::vector<float> scores;
+    for (const Detection& d : r.detections)
+      if (d.bank == b) scores.push_back(d.similarity);
+    ASSERT_EQ(scores.size(), static_cast<std::size_t>(kCap)) << "bank " << b;
+    for (int i = 0; i < kCap; ++i) EXPECT_FLOAT_EQ(scores[static_cast<std::size_t>(i)], every.detections[static_cast<std::size_t>(i)].similarity);
+  }
+  capped.max_per_object = -1;
+  EXPECT_NE(test::inputErrorOf([&] { LinemodBaseline(test::context(), {bank}, capped); }).find("per object"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -95,8 +95,12 @@ void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, i
   EXPECT_GT(reference.size(), 0u);
   ASSERT_EQ(ours.size(), reference.size());
   for (std::size_t i = 0; i < ours.size(); ++i) ASSERT_EQ(ours[i], reference[i]) << "match " << i;
-  // A second run of the same frame gives the very same matches.
+  EXPECT_GE(matcher.lastTimings().attempts, matcher.lastTimings().passes);
+  // A second run of the same frame gives the very same matches, and starts with the buffer
+  // sizes and pass size the first one ended with: nothing overflows and runs again.
   EXPECT_EQ(matcher.match(frame), ours);
+  EXPECT_EQ(matcher.lastTimings().attempts, matcher.lastTimings().passes);
+  EXPECT_GE(matcher.lastTimings().passes, 1u);
 }
 
 TEST(GpuParity, MatchesOnRealFramesBothModalities) {

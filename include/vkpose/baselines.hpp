@@ -36,9 +36,13 @@ struct LinemodBaselineParams {
   /// GPU submit for all matches). Off: the pose sits at the template's training distance,
   /// which is up to half a radius step away from the instance.
   bool depth_offset = true;
+  /// Detections kept per object (bank) and image: the best by similarity. An 8-object LM-O
+  /// frame gives 1.09 M raw matches, whose one-to-one scoring would not finish; 0 keeps all.
+  int max_per_object = 100;
 };
 
-/// Stages 1 and 2 of the detector and nothing else: one detection per raw match.
+/// Stages 1 and 2 of the detector and nothing else: one detection per raw match, the best
+/// max_per_object of each object.
 class LinemodBaseline {
  public:
   /// Banks as the Detector takes them (sharing the first bank's pyramid and modalities).
@@ -47,7 +51,8 @@ class LinemodBaseline {
   LinemodBaseline(const LinemodBaseline&) = delete;
   LinemodBaseline& operator=(const LinemodBaseline&) = delete;
 
-  /// Every match as a Detection: score = similarity / 100, x and y the object centre the
+  /// The best max_per_object matches of each object as Detections (result.matches counts all
+  /// of them): score = similarity / 100, x and y the object centre the
   /// match implies, pose = templatePose() there (with the depth offset when enabled), templates
   /// = 1. Best similarity first. Throws InputError for a frame without depth or a camera whose
   /// principal point lies outside the frame.

@@ -39,12 +39,16 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
 /// Wall-clock of the last frame's GPU work, host side.
 struct MatchTimings {
   double upload_ms = 0;   ///< template upload when the templates or the image size changed
-  double gpu_ms = 0;      ///< the frame's single submit: features, similarity, refinement
+  double features_ms = 0;    ///< stage 1: the frame features' submit
+  double similarity_ms = 0;  ///< stage 2: the similarity passes' submits (coarse and refinement)
   double finish_ms = 0;   ///< host-side sorting and deduplication
   std::size_t coarse_candidates = 0;
   /// Submits of the similarity stage: 1 unless the candidates outgrew one GPU buffer and
   /// the template chunks were split over several passes.
   std::size_t passes = 0;
+  /// Similarity submits including those that overflowed and were run again (passes when
+  /// none did): each overflow costs a pass's work.
+  std::size_t attempts = 0;
 };
 
 namespace gpu {
@@ -52,7 +56,7 @@ class FrameFeatures;
 class Similarity;
 }  // namespace gpu
 
-/// Stages 1 and 2 on the GPU: one command buffer and one submit per frame.
+/// Stages 1 and 2 on the GPU: one submit for the frame features, then one per similarity pass.
 class LinemodMatcher {
  public:
   LinemodMatcher(GpuContext& context, FeatureParams feature_params = {}, MatchParams params = {});
@@ -79,6 +83,9 @@ class LinemodMatcher {
   std::unique_ptr<gpu::Similarity> similarity_;
   std::vector<LinearMemoryLayout> layouts_;
   cv::Size uploaded_for_;  ///< frame size the templates were laid out for
+  /// Template chunks per similarity pass that the last frame got through without overflowing
+  /// (0: all); the next frame starts from it instead of failing its way down again.
+  std::size_t chunks_per_pass_ = 0;
   MatchTimings timings_;
 };
 

@@ -69,4 +69,18 @@ struct SynthSummary {
 SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& params, const std::string& out_dir,
                                       bool overwrite, const std::function<void(int, int)>& progress = {});
 
+/// One image of a random-placement dataset (poses "random"), made in memory from meshes
+/// already loaded (metres): what generateSyntheticDataset would render as image `index` of
+/// these meshes, drawn from the same generator seeded with (seed, index). Meshes without
+/// vertex colours get synth's albedos. For benchmarks and tests that need a frame of a bank's
+/// own mesh (TemplateBank::mesh) without writing files. InputError as validateSynthParams.
+struct SynthImage {
+  LinemodFrame frame;        ///< depth in millimetres
+  Camera camera;             ///< params.camera, depth_scale 1
+  std::vector<int> obj_ids;  ///< per ground-truth instance: 1 + index into the meshes
+  std::vector<Pose> poses;   ///< per ground-truth instance: object-to-camera
+};
+SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
+                           int index);
+
 }  // namespace vkpose

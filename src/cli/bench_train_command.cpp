@@ -12,7 +12,7 @@
 
 namespace vkpose::cli {
 
-void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
+Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
   auto* sub = bench.add_subcommand("train", "Training: templates per second, and cv::linemod on the same renderings");
   auto options = std::make_shared<bench::TrainBenchOptions>();
   auto json_path = std::make_shared<std::string>();
@@ -24,7 +24,7 @@ void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub->add_option("--json", *json_path, "Write the result as JSON to this file (never overwritten)");
-  sub->callback([options, json_path, &global]() {
+  return [options, json_path, &global]() {
     if (!json_path->empty() && std::filesystem::exists(*json_path))
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");
     options->progress = !global.quiet && isatty(STDERR_FILENO);
@@ -51,7 +51,8 @@ void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
                                 {"ratio", r.ratio}};
       std::ofstream(*json_path) << j.dump(2) << "\n";
     }
-  });
+    return kOk;
+  };
 }
 
 }  // namespace vkpose::cli

@@ -39,8 +39,10 @@ void addConfigOption(CLI::App* sub, std::string& path);
 /// The stage parameters of a command: the config file's (when `path` is not empty), overridden
 /// by the flags that differ from the defaults.
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);
-/// `vkpose bench train`, registered under the `bench` subcommand.
-void addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+/// `vkpose bench train`, registered under the `bench` subcommand; the runner runs it.
+Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
+/// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.
+Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global);
 void addBenchSoakCommand(CLI::App& bench, const GlobalOptions& global);  ///< `vkpose bench soak`
 
 }  // namespace vkpose::cli

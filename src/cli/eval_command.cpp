@@ -81,6 +81,11 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str()
       ->group(methods);
+  sub->add_option("--linemod-max-per-object", p.linemod.max_per_object,
+                  "linemod: detections kept per object and image, the best by similarity (0: every raw match)")
+      ->check(CLI::Range(0, 100000000))
+      ->capture_default_str()
+      ->group(methods);
   sub->add_option("--ppf-poses", p.ppf.max_poses, "ppf: poses reported per object and image")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str()

@@ -1,5 +1,8 @@
-// The LINEMOD baseline: raw matches as detections, each with its template's pose.
+// The LINEMOD baseline: raw matches as detections, each with its template's pose, the best
+// few per object.
 #include <chrono>
+
+#include <fmt/format.h>
 
 #include "util/timing.hpp"
 #include "vkpose/baselines.hpp"
@@ -10,6 +13,8 @@ namespace vkpose {
 LinemodBaseline::LinemodBaseline(GpuContext& ctx, std::vector<TemplateBank> banks, LinemodBaselineParams params)
     : ctx_(ctx), banks_(std::move(banks)), params_(params) {
   if (banks_.empty()) throw InputError("the LINEMOD baseline needs at least one template bank");
+  if (params_.max_per_object < 0)
+    throw InputError(fmt::format("detections per object must be 0 (all) or more, not {}", params_.max_per_object));
   for (const auto& b : banks_)
     if (b.templates.empty()) throw InputError("bank '" + b.object + "' has no templates");
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
@@ -27,7 +32,8 @@ DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera&
   const std::vector<Match> matches = matcher_->match(frame);  // best first
   const MatchTimings& mt = matcher_->lastTimings();
   if (mt.upload_ms > 0) result.timings_ms.emplace_back("upload", mt.upload_ms);
-  result.timings_ms.emplace_back("features+similarity", mt.gpu_ms);
+  result.timings_ms.emplace_back("features", mt.features_ms);
+  result.timings_ms.emplace_back("similarity", mt.similarity_ms);
   result.timings_ms.emplace_back("match_readback", mt.finish_ms);
   result.matches = matches.size();
 
@@ -37,8 +43,10 @@ DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera&
   const TemplateIndex index(banks_);
   std::vector<Hypothesis> singles;
   singles.reserve(matches.size());
-  for (const Match& m : matches) {
+  std::vector<int> kept(banks_.size(), 0);
+  for (const Match& m : matches) {  // best first: the first max_per_object of each bank are its best
     const int bank = index.bankOf(m.template_id);
+    if (params_.max_per_object > 0 && kept[static_cast<std::size_t>(bank)]++ >= params_.max_per_object) continue;
     const int local = index.localId(m.template_id);
     const BankTemplate& t = banks_[static_cast<std::size_t>(bank)].templates[static_cast<std::size_t>(local)];
     Hypothesis h;

@@ -264,6 +264,32 @@ DepthNoiseParams synthNoise() {
   return n;
 }
 
+namespace {
+
+/// Image `index` of a dataset: its scene, the rendering and the sensor frame, all drawn from
+/// one generator seeded with (seed, index).
+struct RenderedImage {
+  ImageScene scene;
+  SceneRendering rendering;
+  LinemodFrame frame;
+};
+
+RenderedImage renderImage(const GpuContext& ctx, const SynthParams& p, const std::vector<Mesh>& models,
+                          const std::vector<Pose>& tejani_poses, int index, const Camera& camera) {
+  std::seed_seq seq{p.seed, static_cast<uint32_t>(index), 0x5e7du};
+  std::mt19937 rng(seq);
+  const std::size_t m = static_cast<std::size_t>(index) % models.size();
+  RenderedImage out;
+  out.scene = p.poses == "random" ? randomScene(p, models, rng)
+                                  : tejaniScene(p, models[m], static_cast<int>(m) + 1, tejani_poses, rng);
+  out.rendering = renderScene(ctx, out.scene.objects, camera);
+  applyLighting(out.rendering, randomLighting(out.scene.camera_T_world, rng));
+  out.frame = sensorFrame(out.rendering, p.noise, static_cast<uint32_t>(rng()));
+  return out;
+}
+
+}  // namespace
+
 void validateSynthParams(const SynthParams& p) {
   if (p.meshes.empty()) throw InputError("synth needs at least one mesh");
   if (p.images < 1) throw InputError(fmt::format("--images must be 1 or more, not {}", p.images));
@@ -368,17 +394,11 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
   std::map<int, Camera> cameras;
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < p.images; ++i) {
-    std::seed_seq seq{p.seed, static_cast<uint32_t>(i), 0x5e7du};
-    std::mt19937 rng(seq);
-    const std::size_t m = static_cast<std::size_t>(i) % models.size();
-    ImageScene s = p.poses == "random"
-                       ? randomScene(p, models, rng)
-                       : tejaniScene(p, models[m], static_cast<int>(m) + 1, tejani[static_cast<std::size_t>(i)], rng);
+    const RenderedImage image = renderImage(ctx, p, models, tejani[static_cast<std::size_t>(i)], i, camera);
+    const ImageScene& s = image.scene;
+    const LinemodFrame& frame = image.frame;
     summary.left_out += s.left_out;
-    SceneRendering r = renderScene(ctx, s.objects, camera);
-    applyLighting(r, randomLighting(s.camera_T_world, rng));
-    const LinemodFrame frame = sensorFrame(r, p.noise, static_cast<uint32_t>(rng()));
-    groundTruth(s, r, frame, gt[i], info[i]);
+    groundTruth(s, image.rendering, frame, gt[i], info[i]);
     cameras[i] = camera;
     summary.instances += static_cast<int>(s.obj_ids.size());
     writeImage((scene_dir / "rgb" / fmt::format("{:06d}.png", i)).string(), frame.bgr, false);
@@ -392,6 +412,31 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
   summary.ms_per_image =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / p.images;
   return summary;
+}
+
+SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
+                           int index) {
+  if (models.empty()) throw InputError("synthesizeImage needs at least one mesh");
+  if (params.poses != "random") throw InputError("synthesizeImage places objects itself: use poses \"random\"");
+  SynthParams p = params;
+  p.meshes.assign(models.size(), "model");  // validated as given, not read from files
+  p.images = std::max(p.images, index + 1);
+  validateSynthParams(p);
+  std::vector<Mesh> coloured = models;
+  for (std::size_t i = 0; i < coloured.size(); ++i)
+    if (coloured[i].colours.size() != coloured[i].vertices.size())
+      coloured[i].colours.assign(coloured[i].vertices.size(), kAlbedos[i % std::size(kAlbedos)]);
+  Camera camera = p.camera;
+  camera.depth_scale = 1.0;
+  RenderedImage image = renderImage(ctx, p, coloured, {}, index, camera);
+  SynthImage out;
+  out.frame = std::move(image.frame);
+  out.camera = camera;
+  for (std::size_t i = 0; i < image.scene.obj_ids.size(); ++i) {
+    out.obj_ids.push_back(image.scene.obj_ids[i]);
+    out.poses.push_back(image.scene.objects[i].pose);
+  }
+  return out;
 }
 
 }  // namespace vkpose

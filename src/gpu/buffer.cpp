@@ -1,5 +1,6 @@
 #include "gpu/buffer.hpp"
 
+#include <atomic>
 #include <string>
 #include <utility>
 
@@ -8,6 +9,20 @@
 #include "vkpose/error.hpp"
 
 namespace vkpose::gpu {
+
+namespace {
+std::atomic<std::size_t> live_bytes{0}, peak_bytes{0};
+
+void countAllocation(std::size_t bytes) {
+  const std::size_t now = live_bytes.fetch_add(bytes) + bytes;
+  for (std::size_t peak = peak_bytes.load(); now > peak && !peak_bytes.compare_exchange_weak(peak, now);) {
+  }
+}
+}  // namespace
+
+BufferMemory bufferMemory() { return {live_bytes.load(), peak_bytes.load()}; }
+
+void resetBufferPeak() { peak_bytes = live_bytes.load(); }
 
 Buffer::Buffer(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) { reserve(ctx, bytes, kind); }
 
@@ -46,6 +61,7 @@ void Buffer::release() {
   device_.freeMemory(memory_);
   if (state_) state_->allocated_bytes -= allocated_;
   state_ = nullptr;
+  live_bytes -= allocated_;
   allocated_ = 0;
   device_ = vk::Device{};
   buffer_ = vk::Buffer{};
@@ -91,6 +107,7 @@ void Buffer::reserve(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) 
   allocated_ = req.size;
   s.allocated_bytes += allocated_;
   s.device.bindBufferMemory(buffer_, memory_, 0);
+  countAllocation(allocated_);
   if (host) mapped_ = s.device.mapMemory(memory_, 0, VK_WHOLE_SIZE);
   bytes_ = bytes;
 }

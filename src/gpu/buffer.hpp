@@ -37,10 +37,20 @@ class Buffer {
   vk::Buffer buffer_;
   vk::DeviceMemory memory_;
   std::size_t bytes_ = 0;
+  std::size_t allocated_ = 0;  ///< the memory allocation's size, counted in bufferMemory()
   void* mapped_ = nullptr;
   ContextState* state_ = nullptr;  ///< whose allocated_bytes this buffer counts in
   uint64_t allocated_ = 0;         ///< bytes of memory_
 };
+
+/// Bytes held by live Buffer objects (staging buffers included), and the most held at once
+/// since the process started or the last resetBufferPeak(): a benchmark's GPU memory figure.
+struct BufferMemory {
+  std::size_t live = 0, peak = 0;
+};
+BufferMemory bufferMemory();
+/// Starts a new peak from what is live now.
+void resetBufferPeak();
 
 /// A range of a buffer bound to one shader binding. Ranges must stay within the device's
 /// maxStorageBufferRange (128 MiB on lavapipe): callers chunk larger data.

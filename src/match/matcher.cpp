@@ -1,4 +1,6 @@
-// LinemodMatcher: stages 1 and 2 on the GPU, one command buffer and one submit per frame.
+// LinemodMatcher: stages 1 and 2 on the GPU: one submit for the frame features, one per
+// similarity pass.
+#include <algorithm>
 #include <chrono>
 
 #include "match/frame_features_gpu.hpp"
@@ -28,6 +30,7 @@ void LinemodMatcher::setTemplates(std::vector<LinemodTemplate> templates) {
   validateTemplates(templates, feature_params_);
   templates_ = std::move(templates);
   uploaded_for_ = {};
+  chunks_per_pass_ = 0;
 }
 
 std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
@@ -42,22 +45,32 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
     similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_);
     batch.submit();
     uploaded_for_ = size;
+    chunks_per_pass_ = 0;
     timings_.upload_ms = msSince(t0);
   }
   std::vector<match::CoarseCandidate> candidates, pass_candidates;
   std::vector<match::RefineResult> refined, pass_refined;
   // One pass over all template chunks, unless the candidates outgrow what one binding holds
-  // (many banks at a low threshold): then passes over fewer chunks each, features computed once.
+  // (many banks at a low threshold): then passes over fewer chunks each, features computed
+  // once. A frame starts with the pass size the last one ended with: an overflowing pass
+  // costs as much as one that fits.
   const std::size_t chunks = similarity_->chunkCount();
-  std::size_t per_pass = chunks;
-  features_->record(batch, frame, layouts_);  // submitted with the first pass, kept on the device
+  std::size_t per_pass = chunks_per_pass_ > 0 ? std::min(chunks_per_pass_, chunks) : chunks;
+  std::size_t most_candidates = 0;  // of one pass
+  // Features in a submit of their own (timed apart from similarity; they stay on the device).
+  t0 = std::chrono::steady_clock::now();
+  features_->record(batch, frame, layouts_);
+  batch.submit();
+  timings_.features_ms = msSince(t0);
   for (std::size_t begin = 0, attempt = 0; begin < chunks;) {
     const std::size_t end = std::min(chunks, begin + per_pass);
     t0 = std::chrono::steady_clock::now();
     similarity_->record(batch, *features_, begin, end);
     batch.submit();
-    timings_.gpu_ms += msSince(t0);
+    timings_.similarity_ms += msSince(t0);
+    ++timings_.attempts;
     if (similarity_->read(pass_candidates, pass_refined)) {
+      most_candidates = std::max(most_candidates, pass_candidates.size());
       candidates.insert(candidates.end(), pass_candidates.begin(), pass_candidates.end());
       refined.insert(refined.end(), pass_refined.begin(), pass_refined.end());
       begin = end;
@@ -73,6 +86,8 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
       throw DeviceError("the candidate list keeps overflowing; raise the match threshold");
     }
   }
+  // Passes that stayed under half a binding could cover twice the chunks next time.
+  chunks_per_pass_ = most_candidates < similarity_->maxCandidates() / 2 ? std::min(chunks, 2 * per_pass) : per_pass;
   t0 = std::chrono::steady_clock::now();
   timings_.coarse_candidates = candidates.size();
   auto matches = match::finishMatches(candidates, refined, templates_, feature_params_, params_);

@@ -35,6 +35,8 @@ class Similarity {
   /// must cover fewer chunks.
   bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
   bool full() const { return full_; }
+  /// Candidates one pass can hold at most (one binding's worth).
+  std::size_t maxCandidates() const { return max_capacity_; }
 
  private:
   struct Chunk {

@@ -1,0 +1,316 @@
+#include "bench/detect_benchmark.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <map>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "bench/bench_support.hpp"
+#include "gpu/buffer.hpp"
+#include "vkpose/camera.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/frame_io.hpp"
+#include "vkpose/hypotheses.hpp"
+#include "vkpose/opencv_linemod.hpp"
+#include "vkpose/synth.hpp"
+
+namespace vkpose::bench {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchFrame {
+  LinemodFrame frame;
+  Camera camera;
+};
+
+/// "coffee_cup" and "CoffeeCup" name the same object.
+std::string normalised(const std::string& s) {
+  std::string out;
+  for (const char c : s)
+    if (std::isalnum(static_cast<unsigned char>(c))) out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+bool lmoObjects(const std::vector<TemplateBank>& banks, const fs::path& lmo) {
+  return std::all_of(banks.begin(), banks.end(), [&](const TemplateBank& b) {
+    return b.object.rfind("obj_", 0) == 0 && fs::exists(lmo / "models" / (b.object + ".ply"));
+  });
+}
+
+bool icbinObjects(const std::vector<TemplateBank>& banks) {
+  return std::all_of(banks.begin(), banks.end(), [](const TemplateBank& b) {
+    const std::string n = normalised(b.object);
+    return n.find("cup") != std::string::npos || n.find("juice") != std::string::npos;
+  });
+}
+
+std::vector<BenchFrame> lmoFrames(const fs::path& lmo, std::string& what) {
+  const fs::path scene = lmo / "test" / "000002";
+  if (!fs::exists(scene / "rgb" / "000003.png")) throw InputError("no LM-O frame under " + lmo.string());
+  BenchFrame f;
+  f.camera = loadCamera((lmo / "camera.json").string());
+  f.frame = loadFrame((scene / "rgb" / "000003.png").string(), (scene / "depth" / "000003.png").string(),
+                      f.camera.depth_scale);
+  what = "LM-O test scene 2 image 3 (" + lmo.string() + ")";
+  return {f};
+}
+
+/// The IC-BIN scenes that show the banks' objects: scene 1 juice cartons, 2 cups, 3 both.
+std::vector<BenchFrame> icbinFrames(const fs::path& icbin, const std::vector<TemplateBank>& banks, std::string& what) {
+  bool cup = false, juice = false;
+  for (const auto& b : banks) {
+    const std::string n = normalised(b.object);
+    cup = cup || n.find("cup") != std::string::npos;
+    juice = juice || n.find("juice") != std::string::npos;
+  }
+  std::vector<int> scenes;
+  if (cup) scenes.push_back(2);
+  if (juice) scenes.push_back(1);
+  if (cup || juice || scenes.empty()) scenes.push_back(3);
+  const Camera camera = loadCamera((icbin / "camera.json").string());
+  std::vector<BenchFrame> frames;
+  for (const int s : scenes)
+    for (int i = 0; i < 3; ++i) {
+      const fs::path dir = icbin / fmt::format("scene{}", s);
+      const fs::path rgb = dir / "rgb" / fmt::format("{:04d}.png", i), depth = dir / "depth" / fmt::format("{:04d}.png", i);
+      if (!fs::exists(rgb)) continue;
+      frames.push_back({loadFrame(rgb.string(), depth.string(), camera.depth_scale), camera});
+    }
+  if (frames.empty()) throw InputError("no IC-BIN frames under " + icbin.string());
+  std::string list;
+  for (const int s : scenes) list += (list.empty() ? "" : ", ") + std::to_string(s);
+  what = fmt::format("IC-BIN scenes {} ({} frames, {})", list, frames.size(), icbin.string());
+  return frames;
+}
+
+/// Random table scenes of the banks' own meshes, 1-2 instances each, with clutter and sensor
+/// noise, seen from the distances the banks were trained for, with their focal lengths.
+std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector<TemplateBank>& banks, int count,
+                                        uint32_t seed, std::string& what) {
+  SynthParams p;
+  p.seed = seed;
+  p.images = count;
+  p.min_instances = 1;
+  p.max_instances = 2;
+  const Camera& trained = banks.front().params.camera;
+  p.camera = Camera{trained.fx, trained.fy, 319.5, 239.5, 640, 480, 1.0};
+  float near = banks.front().params.views.radii.from, far = banks.front().params.views.radii.to;
+  for (const auto& b : banks) {
+    near = std::min(near, b.params.views.radii.from);
+    far = std::max(far, b.params.views.radii.to);
+  }
+  p.camera_range.min_height_m = near;
+  p.camera_range.max_height_m = std::max(near, far);
+  std::vector<Mesh> meshes;
+  for (const auto& b : banks) {
+    if (b.mesh.vertices.empty()) throw InputError("bank '" + b.object + "' carries no mesh: retrain it (bank version 2)");
+    meshes.push_back(b.mesh);
+  }
+  std::vector<BenchFrame> frames;
+  for (int i = 0; i < count; ++i) {
+    SynthImage image = synthesizeImage(ctx, p, meshes, i);
+    frames.push_back({std::move(image.frame), image.camera});
+  }
+  what = fmt::format("synthetic: {} random table scenes of the banks' meshes (seed {})", count, seed);
+  return frames;
+}
+
+/// The detector's stage names as the report groups them: the match readback goes with
+/// similarity; the template upload is reported apart.
+const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> groups = {
+      {"features", {"features"}},
+      {"similarity", {"similarity", "match_readback"}},
+      {"clustering", {"clustering"}},
+      {"scoring", {"scoring"}},
+      {"nms", {"nms"}},
+      {"initial_pose", {"initial_pose"}},
+      {"mls", {"mls"}},
+      {"icp", {"icp"}},
+      {"verification", {"verification"}},
+  };
+  return groups;
+}
+
+}  // namespace
+
+FrameSource parseFrameSource(const std::string& name) {
+  if (name == "auto") return FrameSource::Auto;
+  if (name == "lmo") return FrameSource::Lmo;
+  if (name == "icbin") return FrameSource::Icbin;
+  if (name == "synthetic") return FrameSource::Synthetic;
+  throw InputError("frame source '" + name + "' is none of auto, lmo, icbin, synthetic");
+}
+
+DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptions& gpu_options,
+                                     const BenchProgress& progress) {
+  if (o.banks.empty()) throw InputError("bench detect needs at least one --bank");
+  if (o.frames < 1) throw InputError(fmt::format("--frames must be 1 or more, not {}", o.frames));
+  if (o.warmup < 0) throw InputError(fmt::format("--warmup must be 0 or more, not {}", o.warmup));
+  for (const auto& path : o.banks)
+    if (!fs::exists(path)) throw InputError("bank '" + path + "' does not exist");
+  validateDetectorParams(o.params);
+  auto report_progress = [&](const std::string& phase, std::size_t done, std::size_t total) {
+    if (progress) progress(phase, done, total);
+  };
+
+  std::vector<TemplateBank> banks;
+  for (std::size_t i = 0; i < o.banks.size(); ++i) {
+    banks.push_back(loadBank(o.banks[i]));
+    report_progress("loading banks", i + 1, o.banks.size());
+  }
+  DetectBenchReport report;
+  for (const auto& b : banks) report.objects.push_back(b.object);
+
+  const fs::path data = o.data_dir.empty() ? fs::path(VKPOSE_SHARED_DATA_DIR) : fs::path(o.data_dir);
+  const fs::path lmo = data / "lmo_scene2_frame3", icbin = data / "icbin";
+  FrameSource source = o.source;
+  if (source == FrameSource::Auto)
+    source = lmoObjects(banks, lmo) && fs::exists(lmo / "test")  ? FrameSource::Lmo
+             : icbinObjects(banks) && fs::exists(icbin / "camera.json") ? FrameSource::Icbin
+                                                                        : FrameSource::Synthetic;
+
+  GpuContext ctx(gpu_options);
+  report.device = ctx.device().name;
+  std::vector<BenchFrame> frames;
+  if (source == FrameSource::Lmo) frames = lmoFrames(lmo, report.frames_from);
+  else if (source == FrameSource::Icbin) frames = icbinFrames(icbin, banks, report.frames_from);
+  else frames = syntheticFrames(ctx, banks, std::min(o.frames, 8), o.seed, report.frames_from);
+  report.frames = o.frames;
+  report.warmup = o.warmup;
+  report.distinct_frames = static_cast<int>(frames.size());
+
+  const std::vector<LinemodTemplate> templates = o.run_opencv ? concatenateTemplates(banks) : std::vector<LinemodTemplate>{};
+  const FeatureParams features = banks.front().params.features;
+  gpu::resetBufferPeak();
+  Detector detector(ctx, std::move(banks), o.params);
+  report.templates = 0;
+  for (const auto& b : detector.banks()) report.templates += b.templates.size();
+
+  std::map<std::string, std::vector<double>> times;
+  std::vector<double> totals, match_ms;
+  for (int i = 0; i < o.warmup; ++i) {
+    const DetectionResult r = detector.detect(frames[0].frame, frames[0].camera);
+    for (const auto& [stage, ms] : r.timings_ms)
+      if (stage == "upload") report.upload_ms += ms;
+    report_progress("warm-up", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.warmup));
+  }
+  for (int i = 0; i < o.frames; ++i) {
+    const BenchFrame& f = frames[static_cast<std::size_t>(i) % frames.size()];
+    const DetectionResult r = detector.detect(f.frame, f.camera);
+    if (i == 0)
+      for (const auto& w : r.warnings) report.warnings.push_back(w);
+    std::map<std::string, double> by_name(r.timings_ms.begin(), r.timings_ms.end());
+    const double upload = by_name.count("upload") ? by_name["upload"] : 0.0;
+    report.upload_ms += upload;
+    for (const auto& [group, names] : stageGroups()) {
+      double ms = 0;
+      bool ran = false;
+      for (const auto& n : names)
+        if (by_name.count(n)) ms += by_name[n], ran = true;
+      if (ran) times[group].push_back(ms);
+    }
+    totals.push_back(by_name["total"] - upload);
+    match_ms.push_back(by_name["features"] + by_name["similarity"] + by_name["match_readback"]);
+    report.mean_matches += static_cast<double>(r.matches) / o.frames;
+    report.mean_hypotheses += static_cast<double>(r.hypotheses) / o.frames;
+    report.mean_detections += static_cast<double>(r.detections.size()) / o.frames;
+    report_progress("detect", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
+  }
+  for (const auto& [group, names] : stageGroups())
+    if (const auto it = times.find(group); it != times.end()) {
+      double sum = 0;
+      for (const double t : it->second) sum += t;
+      report.stages.push_back({group, median(it->second), percentile(it->second, 95), sum / o.frames});
+    }
+  double total_sum = 0;
+  for (const double t : totals) total_sum += t;
+  report.stages.push_back({"total", median(totals), percentile(totals, 95), total_sum / o.frames});
+  report.frames_per_s = total_sum > 0 ? 1000.0 * o.frames / total_sum : 0.0;
+  report.vkpose_match_ms = median(match_ms);
+  const gpu::BufferMemory gpu_memory = gpu::bufferMemory();
+  report.gpu_peak_bytes = gpu_memory.peak;
+  report.gpu_live_bytes = gpu_memory.live;
+
+  if (o.run_opencv) {
+    // The same templates, threshold and frames, through OpenCV's own LINEMOD matching.
+    auto cv_detector = makeOpenCvDetector(features);
+    const auto modalities = activeModalities(features);
+    for (const auto& t : templates) cv_detector->addSyntheticTemplate(toOpenCvTemplate(t, modalities), "bench");
+    std::vector<double> cv_ms;
+    double matches = 0;
+    for (int i = 0; i < o.frames; ++i) {
+      const BenchFrame& f = frames[static_cast<std::size_t>(i) % frames.size()];
+      std::vector<cv::Mat> sources;
+      if (features.use_colour) sources.push_back(f.frame.bgr);
+      if (features.use_depth) sources.push_back(f.frame.depth_mm);
+      std::vector<cv::linemod::Match> found;
+      cv_ms.push_back(timeMs([&] { cv_detector->match(sources, o.params.match.threshold, found); }));
+      matches += static_cast<double>(found.size()) / o.frames;
+      report_progress("cv::linemod", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
+    }
+    report.opencv_match_ms = median(cv_ms);
+    report.opencv_matches = static_cast<std::size_t>(matches + 0.5);
+    report.opencv_ratio = report.vkpose_match_ms > 0 ? report.opencv_match_ms / report.vkpose_match_ms : 0.0;
+  }
+  report.peak_rss_bytes = peakResidentBytes();
+  return report;
+}
+
+std::string formatDetectReport(const DetectBenchReport& r) {
+  std::string out;
+  std::string objects;
+  for (const auto& o : r.objects) objects += (objects.empty() ? "" : ", ") + o;
+  out += fmt::format("detector, {} frame{} timed after {} warm-up ({} distinct): {}\n", r.frames,
+                     r.frames == 1 ? "" : "s", r.warmup, r.distinct_frames, r.frames_from);
+  out += fmt::format("objects: {} ({} templates)\n", objects, r.templates);
+  out += fmt::format("device: {}\n\n", r.device);
+  out += fmt::format("{:<14} {:>12} {:>12} {:>12}\n", "stage", "median ms", "p95 ms", "mean ms");
+  for (const auto& s : r.stages)
+    out += fmt::format("{:<14} {:>12.1f} {:>12.1f} {:>12.1f}\n", s.stage, s.median_ms, s.p95_ms, s.mean_ms);
+  out += fmt::format("\n{:.3f} frames/s; per frame {:.0f} matches, {:.0f} hypotheses, {:.1f} detections\n",
+                     r.frames_per_s, r.mean_matches, r.mean_hypotheses, r.mean_detections);
+  out += fmt::format("template upload (first frame, not in total): {:.1f} ms\n", r.upload_ms);
+  if (r.opencv_match_ms > 0)
+    out += fmt::format("stages 1-2 vs cv::linemod (same templates, threshold, frames; median): vkpose {:.1f} ms, "
+                       "cv::linemod {:.1f} ms ({} matches), ratio {:.2f}\n",
+                       r.vkpose_match_ms, r.opencv_match_ms, r.opencv_matches, r.opencv_ratio);
+  out += fmt::format("memory: peak resident {}, GPU buffers peak {} (live after the run {})\n",
+                     formatBytes(r.peak_rss_bytes), formatBytes(r.gpu_peak_bytes), formatBytes(r.gpu_live_bytes));
+  return out;
+}
+
+nlohmann::json detectReportJson(const DetectBenchReport& r) {
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& s : r.stages) stages[s.stage] = {{"median_ms", s.median_ms}, {"p95_ms", s.p95_ms}, {"mean_ms", s.mean_ms}};
+  nlohmann::json j = {{"device", r.device},
+                      {"frames_from", r.frames_from},
+                      {"frames", r.frames},
+                      {"warmup", r.warmup},
+                      {"distinct_frames", r.distinct_frames},
+                      {"objects", r.objects},
+                      {"templates", r.templates},
+                      {"stages", stages},
+                      {"frames_per_s", r.frames_per_s},
+                      {"upload_ms", r.upload_ms},
+                      {"mean_matches", r.mean_matches},
+                      {"mean_hypotheses", r.mean_hypotheses},
+                      {"mean_detections", r.mean_detections},
+                      {"memory", {{"peak_rss_bytes", r.peak_rss_bytes},
+                                  {"gpu_peak_bytes", r.gpu_peak_bytes},
+                                  {"gpu_live_bytes", r.gpu_live_bytes}}},
+                      {"warnings", r.warnings}};
+  if (r.opencv_match_ms > 0)
+    j["opencv"] = {{"match_ms", r.opencv_match_ms},
+                   {"vkpose_stages_1_2_ms", r.vkpose_match_ms},
+                   {"ratio", r.opencv_ratio},
+                   {"matches", r.opencv_matches}};
+  return j;
+}
+
+}  // namespace vkpose::bench

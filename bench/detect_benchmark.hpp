@@ -1,0 +1,79 @@
+#pragma once
+// `vkpose bench detect`: the whole Detector pipeline (stages 1-8) over N frames, the time of
+// each stage (median and p95), frames per second and memory; and cv::linemod matching the same
+// templates on the same frames, the baseline of stages 1-2.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "vkpose/detector.hpp"
+#include "vkpose/gpu_context.hpp"
+
+namespace vkpose::bench {
+
+enum class FrameSource { Auto, Lmo, Icbin, Synthetic };
+
+struct DetectBenchOptions {
+  std::vector<std::string> banks;  ///< bank files (.vkpb)
+  int frames = 5;                  ///< frames timed; real frames are cycled when there are fewer
+  /// Frames run first and not timed (the template upload and the driver's first-use shader
+  /// compilation fall into them); 0 times the first frame with them, upload apart.
+  int warmup = 1;
+  /// Auto: LM-O's frame when every bank is an LM-O object (obj_0000NN with its model in the
+  /// data), IC-BIN's frames when every bank is the cup or the juice carton, synthetic frames of
+  /// the banks' own meshes otherwise (and when ../shared/data is absent).
+  FrameSource source = FrameSource::Auto;
+  std::string data_dir;            ///< empty: ../shared/data as built in
+  uint32_t seed = 1;               ///< synthetic frames
+  bool run_opencv = true;
+  DetectorParams params;
+};
+
+/// One stage's times over the frames, milliseconds.
+struct StageStats {
+  std::string stage;
+  double median_ms = 0, p95_ms = 0, mean_ms = 0;
+};
+
+struct DetectBenchReport {
+  std::string device;
+  std::string frames_from;  ///< what the frames are
+  int frames = 0, warmup = 0, distinct_frames = 0;
+  std::vector<std::string> objects;
+  std::size_t templates = 0;
+  double upload_ms = 0;  ///< template upload on the first frame (warm-up or not), never in "total"
+  /// In pipeline order: features, similarity (with the match readback), clustering, scoring,
+  /// nms, initial_pose, mls, icp, verification (those that ran), then total.
+  std::vector<StageStats> stages;
+  double frames_per_s = 0;  ///< frames / sum of the frames' totals
+  double mean_matches = 0, mean_hypotheses = 0, mean_detections = 0;
+  /// cv::linemod on the same frames with the same templates and threshold (0 when not run).
+  double opencv_match_ms = 0;   ///< median per frame
+  double vkpose_match_ms = 0;   ///< median per frame of features + similarity (with readback)
+  double opencv_ratio = 0;      ///< opencv_match_ms / vkpose_match_ms
+  std::size_t opencv_matches = 0;  ///< mean per frame
+  std::size_t peak_rss_bytes = 0;  ///< the process's peak resident memory at the end
+  std::size_t gpu_peak_bytes = 0;  ///< the most bytes our GPU buffers held at once
+  std::size_t gpu_live_bytes = 0;  ///< what they hold after the run (the detector's buffers)
+  std::vector<std::string> warnings;
+};
+
+/// (phase, done, total) as work goes on: "loading banks", "warm-up", "detect", "cv::linemod".
+using BenchProgress = std::function<void(const std::string&, std::size_t, std::size_t)>;
+
+/// Throws InputError for no bank, frames < 1, warmup < 0, a bank that cannot be read, or a source whose
+/// data is missing.
+DetectBenchReport runDetectBenchmark(const DetectBenchOptions& options, const GpuOptions& gpu,
+                                     const BenchProgress& progress = {});
+
+/// The stage table, the throughput, the baseline ratio and the memory, as printed.
+std::string formatDetectReport(const DetectBenchReport& report);
+nlohmann::json detectReportJson(const DetectBenchReport& report);
+
+/// "auto", "lmo", "icbin", "synthetic"; InputError for anything else.
+FrameSource parseFrameSource(const std::string& name);
+
+}  // namespace vkpose::bench
