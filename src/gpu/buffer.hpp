@@ -37,10 +37,10 @@ class Buffer {
   vk::Buffer buffer_;
   vk::DeviceMemory memory_;
   std::size_t bytes_ = 0;
-  std::size_t allocated_ = 0;  ///< the memory allocation's size, counted in bufferMemory()
+  /// The memory allocation's size: counted in bufferMemory() and in the context's budget.
+  std::size_t allocated_ = 0;
   void* mapped_ = nullptr;
   ContextState* state_ = nullptr;  ///< whose allocated_bytes this buffer counts in
-  uint64_t allocated_ = 0;         ///< bytes of memory_
 };
 
 /// Bytes held by live Buffer objects (staging buffers included), and the most held at once
