@@ -23,7 +23,7 @@ const TemplateBank& icbinCupBank() {
     TrainingParams params;
     params.camera = loadCamera(test::sharedData() + "/icbin/camera.json");
     params.symmetric = true;
-    return test::cachedBank("coffee_cup_icbin", loadMesh(test::sharedData() + "/meshes/coffee_cup.stl"), params);
+    return test::cachedBank(loadMesh(test::sharedData() + "/meshes/coffee_cup.stl"), params);
   }();
   return bank;
 }

@@ -60,8 +60,7 @@ const TemplateBank& drillerBank() {
     params.views.radii = {0.9f, 1.1f, 0.1f};
     params.views.inplane_deg = {-45.f, 45.f, 15.f};
     params.camera = loadCamera(lmoRoot() + "/camera.json");
-    return test::cachedBank("lmo_driller_coarse",
-                            loadMesh(lmo().dataset.modelPath(kDriller), MeshUnits::Millimetres), params);
+    return test::cachedBank(loadMesh(lmo().dataset.modelPath(kDriller), MeshUnits::Millimetres), params);
   }();
   return bank;
 }

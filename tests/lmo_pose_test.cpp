@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <map>
 
-#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
@@ -32,7 +31,7 @@ const std::vector<TemplateBank>& lmoBanks() {
       params.views.radii = {0.9f, 1.3f, 0.1f};
       params.symmetric = info.symmetric;
       const Mesh mesh = loadMesh(lmo().modelPath(id), MeshUnits::Millimetres);
-      out.push_back(test::cachedBank(fmt::format("lmo_obj_{:06d}", id), mesh, params));
+      out.push_back(test::cachedBank(mesh, params));
     }
     return out;
   }();

@@ -4,8 +4,8 @@
 #include <memory>
 #include <random>
 
-#include <unistd.h>
 
+#include "vkpose/bank_cache.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/frame_io.hpp"
 #include "vkpose/opencv_linemod.hpp"
@@ -14,29 +14,9 @@ namespace vkpose::test {
 
 std::string sharedData() { return VKPOSE_SHARED_DATA_DIR; }
 
-TemplateBank cachedBank(const std::string& name, const Mesh& mesh, const TrainingParams& params) {
-  const std::string cache = std::string(VKPOSE_TEST_CACHE_DIR) + "/" + name + ".vkpb";
-  if (std::filesystem::exists(cache)) {
-    try {
-      TemplateBank cached = loadBank(cache);
-      const ViewSamplingParams &a = cached.params.views, &b = params.views;
-      auto same = [](const auto& x, const auto& y) { return x.from == y.from && x.to == y.to && x.step == y.step; };
-      if (cached.mesh_hash == mesh.file_hash && a.viewpoints == b.viewpoints && a.full_sphere == b.full_sphere &&
-          same(a.radii, b.radii) && same(a.inplane_deg, b.inplane_deg) &&
-          cached.params.camera.fx == params.camera.fx && cached.params.camera.fy == params.camera.fy &&
-          cached.symmetric == params.symmetric)
-        return cached;
-    } catch (const InputError&) {
-      // A stale or damaged cache: train again.
-    }
-  }
-  TemplateBank bank = trainTemplates(context(), mesh, params);
-  // Written aside and renamed: tests in other processes may read the cache meanwhile.
-  std::filesystem::create_directories(VKPOSE_TEST_CACHE_DIR);
-  const std::string partial = cache + "." + std::to_string(::getpid()) + ".part";
-  saveBank(bank, partial);
-  std::filesystem::rename(partial, cache);
-  return bank;
+TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params) {
+  return loadOrTrainBank(context(), mesh, params, sampleViews(params.views, mesh.bboxCentre()), VKPOSE_TEST_CACHE_DIR)
+      .bank;
 }
 
 bool haveSharedData() { return std::filesystem::exists(sharedData() + "/lmo_scene2_frame3/test/000002/rgb/000003.png"); }

@@ -30,10 +30,10 @@ std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const Feat
 /// The message of the InputError `f` throws; fails the test when it throws nothing.
 std::string inputErrorOf(const std::function<void()>& f);
 
-/// A bank trained from `mesh` with `params`, cached as VKPOSE_TEST_CACHE_DIR/`name`.vkpb
-/// between runs (training takes about a minute per object on 2 cores). A cache from another
-/// mesh, with another template count or another bank version is trained again.
-TemplateBank cachedBank(const std::string& name, const Mesh& mesh, const TrainingParams& params);
+/// A bank trained from `mesh` with `params`, cached in VKPOSE_TEST_CACHE_DIR between runs
+/// under its training key (bank_cache.hpp; training takes about a minute per object on 2
+/// cores): another mesh, other parameters or another bank version train again.
+TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params);
 
 /// One Vulkan context shared by all tests of a process (lavapipe in CI).
 GpuContext& context();

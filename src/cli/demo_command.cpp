@@ -3,6 +3,7 @@
 // and the results, and writes the overlay PNG and the detection JSON.
 #include <fmt/core.h>
 
+#include "bench/bench_support.hpp"
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "vkpose/bank_cache.hpp"
@@ -38,10 +39,7 @@ void printTimings(const std::vector<DemoImageResult>& images) {
     }
   fmt::print("Detection time per image (median over {} image{}):\n", images.size(), images.size() == 1 ? "" : "s");
   std::string line;
-  for (auto& [stage, v] : stages) {
-    std::sort(v.begin(), v.end());
-    line += fmt::format("  {} {:.0f} ms", stage, v[v.size() / 2]);
-  }
+  for (const auto& [stage, v] : stages) line += fmt::format("  {} {:.0f} ms", stage, bench::median(v));
   fmt::print("{}\n", line);
 }
 }  // namespace
