@@ -56,6 +56,7 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
     bar.reset();
     for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
     fmt::print("{}", bench::formatDetectReport(report));
+    printKernelProfile();
     if (!json_path->empty()) {
       writeTextFile(*json_path, bench::detectReportJson(report).dump(2) + "\n", false);
       if (!global.quiet) fmt::print("wrote {}\n", *json_path);

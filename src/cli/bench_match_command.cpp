@@ -14,6 +14,12 @@
 
 namespace vkpose::cli {
 
+void printKernelProfile() {
+  if (gpu::kernelProfile().empty()) return;
+  fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS; a submit per dispatch, so slower than a frame):\n");
+  for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
+}
+
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
   bench->require_subcommand(1);
@@ -118,10 +124,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
     }
     fmt::print("(passes: similarity passes, /submits when some overflowed and ran again; GPU peak: our GPU buffers at "
                "most at once; RSS: resident after vkpose's runs; peak RSS: the process so far)\n");
-    if (!gpu::kernelProfile().empty()) {
-      fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS):\n");
-      for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
-    }
+    printKernelProfile();
     if (!json_path->empty()) {
       std::ofstream f(*json_path);
       if (!f) throw InputError("cannot write '" + *json_path + "'");

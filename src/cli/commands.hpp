@@ -44,5 +44,7 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 /// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.
 Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global);
 void addBenchSoakCommand(CLI::App& bench, const GlobalOptions& global);  ///< `vkpose bench soak`
+/// With VKPOSE_PROFILE_KERNELS set: the milliseconds per kernel the run's dispatches took.
+void printKernelProfile();
 
 }  // namespace vkpose::cli

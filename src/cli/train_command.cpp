@@ -6,7 +6,6 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
-#include "gpu/batch.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/template_bank.hpp"
 
@@ -96,10 +95,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                  1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
       fmt::print("bank: {} ({:.1f} MiB)\n", opt->out, static_cast<double>(bytes) / (1 << 20));
     }
-    if (!gpu::kernelProfile().empty()) {
-      fmt::print("per kernel (VKPOSE_PROFILE_KERNELS):\n");
-      for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
-    }
+    printKernelProfile();
     return kOk;
   };
 }
