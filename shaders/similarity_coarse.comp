@@ -1,6 +1,6 @@
 #version 450
-// Stage 2, coarse level: every template (workgroup row y) at every cell position whose
-// template centre lies in the image; positions over the template's raw threshold are
+// Stage 2, coarse level: every template (workgroup row y) at every cell position of its
+// range (match::coarseRange); positions over the template's raw threshold are
 // appended to the candidate list. An invocation scores ROWS rows of 16 positions, so each
 // feature's offset is read once for them.
 #include "similarity_common.glsl"
@@ -8,21 +8,20 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 3) buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(push_constant) uniform Push {
   int template_base;  // global id of this chunk's first template
-  int columns;        // positions per row (image cells)
-  int rows;           // rows of positions
   int stride;         // bytes per linear-memory row
-  int blocks;         // 16-position blocks per row
   uint capacity;      // candidate slots
 } pc;
 const int ROWS = 4;  // match kCoarseRows in similarity_gpu.cpp
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
-  int bands = (pc.rows + ROWS - 1) / ROWS;
-  if (idx >= bands * pc.blocks) return;
   int t = int(gl_WorkGroupID.y);
   int h = t * HEADER_INTS;
-  int band = idx / pc.blocks;
-  int block = idx - band * pc.blocks;
+  // This template's own range of positions (match::coarseRange): columns, rows.
+  int columns = headers[h + 5], rows = headers[h + 6];
+  int blocks = (columns + 15) / 16;
+  if (idx >= (rows + ROWS - 1) / ROWS * blocks) return;
+  int band = idx / blocks;
+  int block = idx - band * blocks;
   int r0 = headers[h + 3] + band * ROWS;
   int c0 = headers[h + 2] + block * 16;
   int f = headers[h], end = f + headers[h + 1];
@@ -40,8 +39,8 @@ void main() {
     for (int r = 0; r < ROWS; ++r) widen(acc[r], lo[r], hi[r]);
   }
   uint threshold = uint(headers[h + 4]);
-  for (int r = 0; r < ROWS && band * ROWS + r < pc.rows; ++r)
-    for (int p = 0; p < 16 && block * 16 + p < pc.columns; ++p) {
+  for (int r = 0; r < ROWS && band * ROWS + r < rows; ++r)
+    for (int p = 0; p < 16 && block * 16 + p < columns; ++p) {
       uint score = scoreAt(lo[r], hi[r], p);
       if (score > threshold) {
         uint slot = atomicAdd(count, 1u);

@@ -43,6 +43,7 @@ void scoreSixteen(int first, int count, int base, out uvec4 lo, out uvec4 hi) {
 #include "packed_scores.glsl"
 
 // Template header: first feature, feature count, first cell column, first cell row, raw
-// threshold, unused.
+// threshold, then the coarse level's columns and rows of positions (match::coarseRange),
+// unused.
 layout(std430, binding = 1) readonly buffer Templates { int headers[]; };
-const int HEADER_INTS = 6;
+const int HEADER_INTS = 8;

@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rgbd/linemod.hpp>
 
+#include "match/match_geometry.hpp"
 #include "tests/test_support.hpp"
 #include "vkpose/opencv_linemod.hpp"
 
@@ -116,6 +117,51 @@ TEST(FeaturesReference, DepthMedianIsOpenCvsMedianBlur) {
   cv::Mat theirs;
   modality->process(depth, cv::Mat())->quantize(theirs);
   EXPECT_EQ(countDifferent(ours, theirs), 0);
+}
+
+// The coarse range may only drop positions that cannot pass: at every position of the
+// centre-in-image range, a template whose features inside the image could still score
+// above the threshold (4 each) must lie in the trimmed range, and the range must be smaller
+// than the whole image for a template near the size of the frame.
+TEST(CoarseRange, KeepsEveryPositionThatCanPassTheThreshold) {
+  const LinearMemoryLayout layout = makeLinearMemoryLayout(160, 120, 8, 20, 0);
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 40; ++trial) {
+    TemplateLevel level;
+    level.width = rng.uniform(8, 150);
+    level.height = rng.uniform(8, 110);
+    const int n = rng.uniform(1, 64);
+    for (int i = 0; i < n; ++i)
+      level.features.push_back({rng.uniform(0, level.width), rng.uniform(0, level.height), 0, Modality::ColourGradient});
+    for (const float percent : {50.f, 80.f, 95.f}) {
+      const int threshold = match::rawThreshold(n, percent);
+      const auto range = match::coarseRange(level, layout, threshold);
+      const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
+      for (int r = -(hf / 2); r < layout.cells_y - hf / 2; ++r)
+        for (int c = -(wf / 2); c < layout.cells_x - wf / 2; ++c) {
+          int inside = 0;
+          for (const auto& f : level.features) {
+            const int x = c + f.x / layout.T, y = r + f.y / layout.T;
+            inside += x >= 0 && x < layout.cells_x && y >= 0 && y < layout.cells_y;
+          }
+          const bool kept = c >= range.c_lo && c < range.c_lo + range.columns && r >= range.r_lo &&
+                            r < range.r_lo + range.rows;
+          if (4 * inside > threshold) {
+            EXPECT_TRUE(kept) << "trial " << trial << " at " << c << "," << r;
+          }
+        }
+    }
+  }
+  TemplateLevel wide;
+  wide.width = 150;
+  wide.height = 110;
+  for (int y = 0; y < 110; y += 10)
+    for (int x = 0; x < 150; x += 10) wide.features.push_back({x, y, 0, Modality::ColourGradient});
+  const int n = static_cast<int>(wide.features.size());
+  const auto range = match::coarseRange(wide, layout, match::rawThreshold(n, 80.f));
+  EXPECT_LT(range.columns, layout.cells_x / 2);
+  EXPECT_LT(range.rows, layout.cells_y / 2);
+  EXPECT_GT(range.columns * range.rows, 0);
 }
 
 }  // namespace

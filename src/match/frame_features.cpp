@@ -2,6 +2,8 @@
 // the CPU pyramid.
 #include <algorithm>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "match/match_geometry.hpp"
 #include "vkpose/error.hpp"
@@ -76,6 +78,39 @@ std::vector<cv::Size> levelSizes(int width, int height, std::size_t levels) {
     height /= 2;
   }
   return sizes;
+}
+
+namespace {
+/// The [first, last] positions p of `range` (p_lo .. p_lo + count - 1) at which at least
+/// `need` of the sorted feature cells land inside 0 .. cells - 1; an empty range when none.
+std::pair<int, int> positionsWithEnoughInside(const std::vector<int>& sorted_cells, int p_lo, int count, int cells,
+                                              int need) {
+  const auto inside = [&](int p) {
+    const auto lo = std::lower_bound(sorted_cells.begin(), sorted_cells.end(), -p);
+    const auto hi = std::lower_bound(sorted_cells.begin(), sorted_cells.end(), cells - p);
+    return static_cast<int>(hi - lo);
+  };
+  int first = p_lo, last = p_lo + count - 1;
+  while (first <= last && inside(first) < need) ++first;
+  while (last >= first && inside(last) < need) --last;
+  return {first, last};
+}
+}  // namespace
+
+CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold) {
+  const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
+  const int need = std::max(raw_threshold, 0) / 4 + 1;
+  std::vector<int> xs, ys;
+  for (const auto& f : level.features) {
+    xs.push_back(f.x / layout.T);
+    ys.push_back(f.y / layout.T);
+  }
+  std::sort(xs.begin(), xs.end());
+  std::sort(ys.begin(), ys.end());
+  const auto [c0, c1] = positionsWithEnoughInside(xs, -(wf / 2), layout.cells_x, layout.cells_x, need);
+  const auto [r0, r1] = positionsWithEnoughInside(ys, -(hf / 2), layout.cells_y, layout.cells_y, need);
+  if (c1 < c0 || r1 < r0) return {c0, r0, 0, 0};
+  return {c0, r0, c1 - c0 + 1, r1 - r0 + 1};
 }
 
 std::vector<LinearMemoryLayout> makeLayouts(const std::vector<LinemodTemplate>& templates,

@@ -8,7 +8,7 @@
 namespace vkpose::gpu {
 
 namespace {
-constexpr int kHeaderInts = 6;
+constexpr int kHeaderInts = 8;  // HEADER_INTS in shaders/similarity_common.glsl
 constexpr uint32_t kGroup = 64;
 constexpr int kCoarseRows = 4;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
 constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
@@ -21,7 +21,7 @@ struct UnitGrid {
   int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0;
 };
 struct CoarsePush {
-  int32_t template_base, columns, rows, stride, blocks;
+  int32_t template_base, stride;
   uint32_t capacity;
 };
 struct UnitsPush {
@@ -104,10 +104,15 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
       for (std::size_t l = 0; l < levels; ++l) {
         const auto& level = templates[t].levels[l];
         const auto& layout = layouts[l];
-        const auto range = match::coarseRange(level, layout);
         const int n = static_cast<int>(level.features.size());
+        const int threshold = match::rawThreshold(n, params.threshold);
+        const auto range = match::coarseRange(level, layout, threshold);
         headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
-                                             match::rawThreshold(n, params.threshold), 0});
+                                             threshold, range.columns, range.rows, 0});
+        if (l + 1 == levels)
+          chunk.coarse_invocations = std::max<std::size_t>(
+              chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
+                                            static_cast<std::size_t>((range.columns + 15) / 16));
         const int T = layout.T;
         for (const auto& f : level.features)
           offsets[l].push_back(static_cast<int32_t>(
@@ -150,16 +155,16 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     units_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * 4);
     scores_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * kUnitScoreBytes);
   }
-  const int blocks = (cl.cells_x + match::kRefineWindow - 1) / match::kRefineWindow;
   const auto& fl = layouts_[0];
   for (std::size_t c = begin; c < std::min(end, chunks_.size()); ++c) {
     const Chunk& chunk = chunks_[c];
     const std::size_t words = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands) *
                               static_cast<std::size_t>(grid.words_per_band);
-    const CoarsePush push{chunk.first_template, cl.cells_x, cl.cells_y, cl.stride, blocks, capacity_};
-    batch.dispatch(kernels_->coarse, {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_},
-                   push, groupsFor(static_cast<std::size_t>((cl.cells_y + kCoarseRows - 1) / kCoarseRows * blocks), kGroup),
-                   static_cast<uint32_t>(chunk.template_count));
+    const CoarsePush push{chunk.first_template, cl.stride, capacity_};
+    if (chunk.coarse_invocations > 0)
+      batch.dispatch(kernels_->coarse,
+                     {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_}, push,
+                     groupsFor(chunk.coarse_invocations, kGroup), static_cast<uint32_t>(chunk.template_count));
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);

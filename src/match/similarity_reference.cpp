@@ -91,7 +91,7 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
                               memories[l]);
   }
 
-  // Coarse level: every template at every position.
+  // Coarse level: every template at every position that can pass (match::coarseRange).
   const std::size_t coarse = pyramid.size() - 1;
   const auto& cl = layouts[coarse];
   std::vector<match::CoarseCandidate> candidates;
@@ -99,7 +99,7 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
   for (std::size_t ti = 0; ti < templates.size(); ++ti) {
     const auto& level = templates[ti].levels[coarse];
     const int threshold = match::rawThreshold(static_cast<int>(level.features.size()), params.threshold);
-    const auto range = match::coarseRange(level, cl);
+    const auto range = match::coarseRange(level, cl, threshold);
     for (int r = range.r_lo; r < range.r_lo + range.rows; ++r)
       for (int c0 = range.c_lo; c0 < range.c_lo + range.columns; c0 += match::kRefineWindow) {
         scoreRow(memories[coarse], cl, level, r, c0, scores);
