@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Configures, builds (warnings are errors) and runs the whole test suite with ctest, every test
-# under the Vulkan validation layer (a validation error fails the test that caused it). The
-# `asan` preset (AddressSanitizer + UndefinedBehaviorSanitizer) is not run here yet: see
-# README.md, "Reliability", for what it still reports.
+# under the Vulkan validation layer (a validation error fails the test that caused it); then
+# the `asan` preset (AddressSanitizer + UndefinedBehaviorSanitizer) builds and runs the tests
+# of the CPU stages, the file readers and the CLI (README.md, "Reliability").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release >/dev/null
 cmake --build --preset release
 ctest --preset release
+cmake --preset asan >/dev/null
+cmake --build --preset asan
+ctest --preset asan
