@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "gpu/buffer.hpp"
 #include "mesh_support.hpp"
 #include "test_support.hpp"
 #include "vkpose/error.hpp"
@@ -210,6 +211,30 @@ TEST(Render, ManyViewsSplitIntoBatches) {
   ASSERT_EQ(renders.size(), poses.size());
   EXPECT_NEAR(renders.back().depth.at<float>(static_cast<int>(cam.cy), static_cast<int>(cam.cx)), 0.75f, 1e-3f);
   EXPECT_NEAR(renders.front().depth.at<float>(static_cast<int>(cam.cy), static_cast<int>(cam.cx)), 0.45f, 1e-3f);
+}
+
+// Renderers sharing a workspace (the detector's, one per bank) hold the full-frame outputs
+// once: the second mesh's render allocates nothing more, and still draws its own mesh.
+TEST(Render, RenderersSharingAWorkspaceAllocateItOnce) {
+  const Mesh small = test::icosphere(0.03f, 2), large = test::icosphere(0.06f, 2);
+  const Camera cam = smallCamera(320, 240);
+  const std::vector<Pose> poses(3, Pose{Eigen::Matrix3f::Identity(), Eigen::Vector3f(0, 0, 0.5f)});
+  const auto workspace = makeRenderWorkspace(test::context());
+  MeshRenderer a(test::context(), small, workspace), b(test::context(), large, workspace);
+  const auto first = a.render(cam, poses);
+  const std::size_t after_first = gpu::bufferMemory().live;
+  const auto second = b.render(cam, poses);
+  EXPECT_EQ(gpu::bufferMemory().live, after_first);
+  const cv::Point centre(static_cast<int>(cam.cx), static_cast<int>(cam.cy));
+  EXPECT_NEAR(first[0].depth.at<float>(centre), 0.47f, 2e-3f);
+  EXPECT_NEAR(second[2].depth.at<float>(centre), 0.44f, 2e-3f);
+  EXPECT_GT(cv::countNonZero(second[0].mask()), 2 * cv::countNonZero(first[0].mask()));
+  {
+    MeshRenderer own(test::context(), small);  // no workspace given: one of its own
+    own.render(cam, poses);
+    EXPECT_GT(gpu::bufferMemory().live, after_first + std::size_t{3} * 320 * 240 * 32);
+  }
+  EXPECT_EQ(gpu::bufferMemory().live, after_first);
 }
 
 TEST(Render, BadCameraIsAnInputError) {

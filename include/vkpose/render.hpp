@@ -41,9 +41,18 @@ Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy)
 
 /// Renders a mesh on the GPU. The mesh stays on the device; render() splits the views into
 /// batches that fit the device's buffer limits, one submit per batch.
+/// The command batch, staging memory and full-frame outputs MeshRenderer::render works in:
+/// about 56 bytes per pixel and pose of a batch (up to about 170 MiB at 640x480). Renderers that
+/// never render at the same time (the detector's, one per bank, render one after another)
+/// share one, so N meshes hold it once rather than N times.
+struct RenderWorkspace;
+std::shared_ptr<RenderWorkspace> makeRenderWorkspace(const GpuContext& ctx);
+
 class MeshRenderer {
  public:
-  MeshRenderer(const GpuContext& ctx, const Mesh& mesh);
+  /// Without `workspace` the renderer has one of its own; with it, the caller promises that
+  /// the renderers sharing it never render concurrently.
+  MeshRenderer(const GpuContext& ctx, const Mesh& mesh, std::shared_ptr<RenderWorkspace> workspace = {});
   ~MeshRenderer();
   MeshRenderer(const MeshRenderer&) = delete;
   MeshRenderer& operator=(const MeshRenderer&) = delete;

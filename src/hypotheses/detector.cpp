@@ -203,8 +203,12 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     dets[i].rotation_votes = rot.group_size;
     rendered[i] = poseOnViewingRay(rot.R, h, bank, camera);
   }
-  if (renderers_.empty())
-    for (const auto& b : banks_) renderers_.push_back(std::make_unique<MeshRenderer>(ctx_, b.mesh));
+  if (renderers_.empty()) {
+    // One workspace for all banks: they render one after another, and each renderer with its
+    // own held up to about 170 MiB of full-frame outputs and staging (1.3 GiB for 8 objects).
+    const auto workspace = makeRenderWorkspace(ctx_);
+    for (const auto& b : banks_) renderers_.push_back(std::make_unique<MeshRenderer>(ctx_, b.mesh, workspace));
+  }
   std::vector<Rendering> renderings(n);
   for (std::size_t b = 0; b < banks_.size(); ++b) {
     std::vector<std::size_t> which;

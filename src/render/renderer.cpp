@@ -137,10 +137,21 @@ constexpr std::size_t kBatchBytes = 96u << 20;  // per-batch output budget
 constexpr std::size_t kMaxViewsPerBatch = 256;
 }  // namespace
 
+struct RenderWorkspace {
+  explicit RenderWorkspace(const GpuContext& c) : batch(c) {}
+  gpu::Batch batch;  ///< one command buffer and fence, reused by every render()
+  gpu::Buffer poses, keys, depth, normal_out, colour_out;
+};
+
+std::shared_ptr<RenderWorkspace> makeRenderWorkspace(const GpuContext& ctx) {
+  return std::make_shared<RenderWorkspace>(ctx);
+}
+
 struct MeshRenderer::Impl {
-  Impl(const GpuContext& c, const Mesh& mesh)
+  Impl(const GpuContext& c, const Mesh& mesh, std::shared_ptr<RenderWorkspace> ws)
       : ctx(c),
-        batch(c),
+        workspace(ws ? std::move(ws) : makeRenderWorkspace(c)),
+        batch(workspace->batch),
         raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush)),
         resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush)) {
     face_count = static_cast<uint32_t>(mesh.faces.size());
@@ -170,18 +181,19 @@ struct MeshRenderer::Impl {
     batch.submit();
   }
   const GpuContext& ctx;
-  gpu::Batch batch;  ///< reused by every render(): one command buffer and fence
+  std::shared_ptr<RenderWorkspace> workspace;
+  gpu::Batch& batch;
   gpu::Kernel raster, resolve;
-  gpu::Buffer vertices, faces, normals, colours, poses, keys, depth, normal_out, colour_out;
+  gpu::Buffer vertices, faces, normals, colours;
   uint32_t face_count = 0, flags = 0;
 };
 
-MeshRenderer::MeshRenderer(const GpuContext& ctx, const Mesh& mesh) {
+MeshRenderer::MeshRenderer(const GpuContext& ctx, const Mesh& mesh, std::shared_ptr<RenderWorkspace> workspace) {
   if (!ctx.device().int64_atomics)
     throw DeviceError(fmt::format("the template renderer needs 64-bit buffer atomics, which {} lacks",
                                   ctx.device().name));
   if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles to render", mesh.name));
-  impl_ = std::make_unique<Impl>(ctx, mesh);
+  impl_ = std::make_unique<Impl>(ctx, mesh, std::move(workspace));
 }
 
 MeshRenderer::~MeshRenderer() = default;
@@ -197,6 +209,7 @@ std::size_t MeshRenderer::viewsPerBatch(const Camera& camera) const {
 std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses) {
   validateCamera(camera, "render camera");
   auto& m = *impl_;
+  auto& w = *m.workspace;
   const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
   if (pixels * 16 > m.ctx.device().max_storage_buffer_range)
     throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
@@ -213,25 +226,25 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     for (std::size_t v = first; v < first + n; ++v)
       for (int r = 0; r < 3; ++r)
         rows.insert(rows.end(), {poses[v].R(r, 0), poses[v].R(r, 1), poses[v].R(r, 2), poses[v].t(r)});
-    m.poses.reserve(m.ctx, rows.size() * 4);
-    m.keys.reserve(m.ctx, n * pixels * 8);
-    m.depth.reserve(m.ctx, n * pixels * 4);
-    m.normal_out.reserve(m.ctx, n * pixels * 16);
-    m.colour_out.reserve(m.ctx, n * pixels * 4);
+    w.poses.reserve(m.ctx, rows.size() * 4);
+    w.keys.reserve(m.ctx, n * pixels * 8);
+    w.depth.reserve(m.ctx, n * pixels * 4);
+    w.normal_out.reserve(m.ctx, n * pixels * 16);
+    w.colour_out.reserve(m.ctx, n * pixels * 4);
     depth.resize(n * pixels);
     normals.resize(n * pixels * 4);
     colour.resize(n * pixels);
     gpu::Batch& batch = m.batch;
-    batch.upload(m.poses, rows.data(), rows.size() * 4);
-    batch.fill(m.keys, 0xFFFFFFFFu, n * pixels * 8);
-    batch.dispatch(m.raster, {m.vertices, m.faces, m.poses, m.keys}, push, gpu::groupsFor(m.face_count, 64),
+    batch.upload(w.poses, rows.data(), rows.size() * 4);
+    batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
+    batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
                    static_cast<uint32_t>(n));
     batch.dispatch(m.resolve,
-                   {m.vertices, m.faces, m.poses, m.keys, m.normals, m.colours, m.depth, m.normal_out, m.colour_out},
+                   {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
                    push, gpu::groupsFor(pixels, 64), static_cast<uint32_t>(n));
-    batch.download(m.depth, depth.data(), n * pixels * 4);
-    batch.download(m.normal_out, normals.data(), n * pixels * 16);
-    batch.download(m.colour_out, colour.data(), n * pixels * 4);
+    batch.download(w.depth, depth.data(), n * pixels * 4);
+    batch.download(w.normal_out, normals.data(), n * pixels * 16);
+    batch.download(w.colour_out, colour.data(), n * pixels * 4);
     batch.submit();
     for (std::size_t v = 0; v < n; ++v) {
       Rendering r;
