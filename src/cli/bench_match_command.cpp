@@ -28,6 +28,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   const Runner detect = addBenchDetectCommand(*bench, global);
   auto* detect_command = bench->get_subcommand("detect");
   addBenchSoakCommand(*bench, global);  // runs in its parse callback
+  auto* soak_command = bench->get_subcommand("soak");
   auto* match = bench->add_subcommand("match", "LINEMOD matching: vkpose vs OpenCV's cv::linemod, same templates");
   auto options = std::make_shared<bench::MatchBenchOptions>();
   auto json_path = std::make_shared<std::string>();
@@ -63,9 +64,11 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
                     "Objects sweep: each object is a copy of this bank's templates (default: templates cut from the "
                     "frame)");
   match->add_option("--json", *json_path, "Write the results as JSON to this file (never overwritten)");
-  return [options, json_path, sweep, templates_option, train, train_command, detect, detect_command, &global]() {
+  return [options, json_path, sweep, templates_option, train, train_command, detect, detect_command, soak_command,
+          &global]() {
     if (train_command->parsed()) return train();
     if (detect_command->parsed()) return detect();
+    if (soak_command->parsed()) return static_cast<int>(kOk);  // it ran (and passed) inside parse()
     if (options->rgb.empty() != options->depth.empty()) throw InputError("--rgb and --depth go together");
     if (!json_path->empty() && std::ifstream(*json_path).good())
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");
