@@ -81,34 +81,42 @@ std::vector<cv::Size> levelSizes(int width, int height, std::size_t levels) {
 }
 
 namespace {
-/// The [first, last] positions p of `range` (p_lo .. p_lo + count - 1) at which at least
-/// `need` of the sorted feature cells land inside 0 .. cells - 1; an empty range when none.
-std::pair<int, int> positionsWithEnoughInside(const std::vector<int>& sorted_cells, int p_lo, int count, int cells,
+/// The [first, last] positions p of p_lo .. p_lo + count - 1 at which at least `need`
+/// features (their cells counted in `below`: below[k] features have a cell < k) land inside
+/// 0 .. cells - 1; first > last when none.
+std::pair<int, int> positionsWithEnoughInside(const std::vector<int>& below, int p_lo, int count, int cells,
                                               int need) {
-  const auto inside = [&](int p) {
-    const auto lo = std::lower_bound(sorted_cells.begin(), sorted_cells.end(), -p);
-    const auto hi = std::lower_bound(sorted_cells.begin(), sorted_cells.end(), cells - p);
-    return static_cast<int>(hi - lo);
-  };
+  const int span = static_cast<int>(below.size()) - 1;
+  const auto cellsBelow = [&](int k) { return below[static_cast<std::size_t>(std::clamp(k, 0, span))]; };
+  const auto inside = [&](int p) { return cellsBelow(cells - p) - cellsBelow(-p); };
   int first = p_lo, last = p_lo + count - 1;
   while (first <= last && inside(first) < need) ++first;
   while (last >= first && inside(last) < need) --last;
   return {first, last};
 }
+
+/// below[k]: how many of `cells` are < k, for k = 0 .. max cell + 1.
+std::vector<int> cumulativeCounts(const std::vector<int>& cells) {
+  std::vector<int> below(static_cast<std::size_t>(*std::max_element(cells.begin(), cells.end()) + 2), 0);
+  for (const int c : cells) ++below[static_cast<std::size_t>(c) + 1];
+  for (std::size_t k = 1; k < below.size(); ++k) below[k] += below[k - 1];
+  return below;
+}
 }  // namespace
 
 CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold) {
   const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
+  if (level.features.empty()) return {-(wf / 2), -(hf / 2), 0, 0};
   const int need = std::max(raw_threshold, 0) / 4 + 1;
   std::vector<int> xs, ys;
+  xs.reserve(level.features.size());
+  ys.reserve(level.features.size());
   for (const auto& f : level.features) {
     xs.push_back(f.x / layout.T);
     ys.push_back(f.y / layout.T);
   }
-  std::sort(xs.begin(), xs.end());
-  std::sort(ys.begin(), ys.end());
-  const auto [c0, c1] = positionsWithEnoughInside(xs, -(wf / 2), layout.cells_x, layout.cells_x, need);
-  const auto [r0, r1] = positionsWithEnoughInside(ys, -(hf / 2), layout.cells_y, layout.cells_y, need);
+  const auto [c0, c1] = positionsWithEnoughInside(cumulativeCounts(xs), -(wf / 2), layout.cells_x, layout.cells_x, need);
+  const auto [r0, r1] = positionsWithEnoughInside(cumulativeCounts(ys), -(hf / 2), layout.cells_y, layout.cells_y, need);
   if (c1 < c0 || r1 < r0) return {c0, r0, 0, 0};
   return {c0, r0, c1 - c0 + 1, r1 - r0 + 1};
 }

@@ -106,7 +106,8 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         const auto& layout = layouts[l];
         const int n = static_cast<int>(level.features.size());
         const int threshold = match::rawThreshold(n, params.threshold);
-        const auto range = match::coarseRange(level, layout, threshold);
+        // Only the coarse level scans a range; the finer one scores the units of refinement.
+        const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold) : match::CoarseRange{};
         headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
                                              threshold, range.columns, range.rows, 0});
         if (l + 1 == levels)
