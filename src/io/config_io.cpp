@@ -157,13 +157,19 @@ DetectorParams parseConfig(const std::string& text, const std::string& source, c
   if (!doc.is_object()) throw InputError(fmt::format("{}: a config file is a JSON object of sections", source));
   DetectorParams p = base;
   std::vector<ConfigField> fields = configFields(p);
-  for (const auto& [section, keys] : doc.items()) {
+  // Plain names, not structured bindings: clang 14 (the fuzz preset) cannot capture those in
+  // the lambdas below.
+  for (const auto& entry : doc.items()) {
+    const std::string& section = entry.key();
+    const json& keys = entry.value();
     if (std::none_of(fields.begin(), fields.end(), [&](const ConfigField& f) { return f.section == section; }))
       throw InputError(
           fmt::format("{}: unknown section \"{}\" (see vkpose config --print-defaults)", source, section));
     if (!keys.is_object())
       throw InputError(fmt::format("{}: \"{}\" must be an object of parameters", source, section));
-    for (const auto& [key, value] : keys.items()) {
+    for (const auto& item : keys.items()) {
+      const std::string& key = item.key();
+      const json& value = item.value();
       const auto it = std::find_if(fields.begin(), fields.end(),
                                    [&](const ConfigField& f) { return f.section == section && f.key == key; });
       if (it == fields.end()) {
