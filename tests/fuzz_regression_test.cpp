@@ -11,6 +11,7 @@
 
 #include "tests/test_support.hpp"
 #include "vkpose/camera.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/template_bank.hpp"
@@ -151,6 +152,30 @@ TEST(FuzzRegression, BankWithANanViewRangeIsAnInputError) {
   p = {};
   p.radii = {0.5f, 6.f, 1e-9f};  // 5.5e9 values: refused before listing them
   EXPECT_THROW(validateViewSampling(p), InputError);
+}
+
+
+// fuzz_config (the seed tests/fuzz_corpus/config/wrong_types.json): a number no double holds.
+// nlohmann::json reports it as out_of_range, not parse_error, and parseConfig let it escape.
+TEST(FuzzRegression, ConfigWithANumberOverflowIsAnInputError) {
+  const std::string bytes = "{\"nms\": {\"radius_px\": \"3\"}, \"verify\": {\"threshold\": 1e400}}\n";
+  try {
+    loadConfig(writeInput("overflow.json", bytes));
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a JSON config file"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_config's read-back check (found by hand, with an input written for it): a float just
+// below FLT_MAX prints as 3.4028235e+38, which read back as a double is above FLT_MAX, and
+// parseConfig refused what configJson (vkpose config --check) had printed.
+TEST(FuzzRegression, ConfigNearFloatMaxReadsBackAsPrinted) {
+  const DetectorParams p = parseConfig(R"({"score": {"depth_unit_m": 3.4028234e38}})", "big.json");
+  EXPECT_EQ(p.score.depth_unit_m, std::numeric_limits<float>::max());
+  const std::string printed = configJson(p);
+  EXPECT_EQ(configJson(parseConfig(printed, "printed.json")), printed);
+  EXPECT_THROW(parseConfig(R"({"score": {"depth_unit_m": 3.5e38}})", "inf.json"), InputError) << "no float holds it";
 }
 
 }  // namespace
