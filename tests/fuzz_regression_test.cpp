@@ -14,6 +14,7 @@
 #include "vkpose/config.hpp"
 #include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/mesh.hpp"
 #include "vkpose/template_bank.hpp"
 #include "vkpose/views.hpp"
 
@@ -176,6 +177,56 @@ TEST(FuzzRegression, ConfigNearFloatMaxReadsBackAsPrinted) {
   const std::string printed = configJson(p);
   EXPECT_EQ(configJson(parseConfig(printed, "printed.json")), printed);
   EXPECT_THROW(parseConfig(R"({"score": {"depth_unit_m": 3.5e38}})", "inf.json"), InputError) << "no float holds it";
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/no_end_header.ply.bin, whose first byte picked .ply): a
+// PLY whose end_header line is damaged. assimp 5.2 loops for ever looking for it; loadMesh
+// now refuses the header first.
+const std::string kPlyWithoutEndHeader(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x         \n"
+    "property float32 y         \n"
+    "property float32 z         \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_index \n"
+    "end\x99"
+    "header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\n"
+    "4 0 5\n"
+    "v 0.5 0.5 -0.5\n"
+    "v 0.5 0.5 0.5\n"
+    "\n"
+    "# Point/Line/Face list\n"
+    "\n"
+    "usemtl Default\n"
+    "f 4 3 2 1\n"
+    "f 2 6 5 1\n"
+    "f 3 7 6 2\n"
+    "f 8 7 3 4\n"
+    "f 5 8 4 11 2 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4$clr.ambi 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyWithoutEndHeaderIsAnInputError) {
+  ASSERT_EQ(kPlyWithoutEndHeader.size(), 458u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyWithoutEndHeader), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no end_header line"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -1,10 +1,15 @@
 #include "vkpose/mesh.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <sstream>
+#include <string_view>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -122,6 +127,86 @@ std::vector<char> readFile(const std::string& path) {
   if (bytes.empty()) throw InputError(fmt::format("{}: the mesh file is empty", path));
   return bytes;
 }
+
+/// The bytes of a PLY scalar type; 0 for a name this check does not know.
+std::size_t plyScalarBytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+/// Refuses two kinds of PLY on which assimp 5.2 hangs instead of failing, both found by
+/// fuzz_mesh: a header without its end_header line (assimp loops at the end of the file for
+/// ever), and a header declaring more element instances than the data after it can hold
+/// (assimp sizes its arrays and loops by the declared counts before it finds the data
+/// missing: 100 bytes declaring 50 million vertices take 600 MB and half a minute). A header
+/// line this check does not understand leaves the counts to assimp.
+void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
+  const std::string_view text(bytes.data(), bytes.size());
+  // assimp's own test: the first three bytes, in any case.
+  if (text.size() < 3 || std::tolower(static_cast<unsigned char>(text[0])) != 'p' ||
+      std::tolower(static_cast<unsigned char>(text[1])) != 'l' ||
+      std::tolower(static_cast<unsigned char>(text[2])) != 'y')
+    return;
+  std::size_t pos = 0;
+  auto nextLine = [&](std::vector<std::string>& tokens) {
+    if (pos >= text.size()) return false;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::istringstream in{std::string(text.substr(pos, end - pos))};
+    tokens.clear();
+    for (std::string t; in >> t;) tokens.push_back(t);
+    pos = end + 1;
+    return true;
+  };
+  struct Element {
+    std::string name;
+    uint64_t count = 0;
+    uint64_t least = 0;  // bytes (binary) or values (ASCII) one instance takes at least
+  };
+  std::vector<Element> elements;
+  bool ascii = false, known_format = false, understood = true;
+  std::vector<std::string> t;
+  nextLine(t);  // the magic line
+  for (;;) {
+    if (!nextLine(t))
+      throw InputError(fmt::format("{}: the PLY header has no end_header line (a truncated or corrupt file)", path));
+    if (!t.empty() && t[0] == "end_header") break;
+    if (!understood || t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "format" && t.size() >= 2) {
+      ascii = t[1] == "ascii";
+      known_format = ascii || t[1] == "binary_little_endian" || t[1] == "binary_big_endian";
+    } else if (t[0] == "element" && t.size() == 3 && known_format) {
+      Element e{t[1]};
+      const char* end = t[2].data() + t[2].size();
+      understood = std::from_chars(t[2].data(), end, e.count).ptr == end;
+      elements.push_back(e);
+    } else if (t[0] == "property" && !elements.empty()) {
+      // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
+      // count at least (it may be empty).
+      const bool list = t.size() == 5 && t[1] == "list";
+      const std::size_t size = plyScalarBytes(list ? t[2] : t[1]);
+      understood = (list || t.size() == 3) && size > 0 && (!list || plyScalarBytes(t[3]) > 0);
+      elements.back().least += ascii ? 1 : size;
+    } else {
+      understood = false;
+    }
+  }
+  if (!understood || !known_format) return;
+  // ASCII: n values of a character each need n - 1 separators too, so n <= (bytes + 1) / 2.
+  const uint64_t data = text.size() - std::min(pos, text.size());
+  uint64_t room = ascii ? (data + 1) / 2 : data;
+  for (const Element& e : elements) {
+    if (e.least == 0) continue;
+    if (e.count > room / e.least)
+      throw InputError(fmt::format("{}: the PLY header declares {} '{}' elements, more than the {} bytes after the "
+                                   "header can hold (a truncated or corrupt file)",
+                                   path, e.count, e.name, data));
+    room -= e.count * e.least;
+  }
+}
 }  // namespace
 
 Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) {
@@ -133,6 +218,9 @@ Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) 
   std::string lower_ext = ext;
   std::transform(lower_ext.begin(), lower_ext.end(), lower_ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
   const bool drop_normals = lower_ext == ".stl";
+  // The STL and OBJ importers, which assimp picks by these extensions, never read a file as
+  // PLY; any other name may reach assimp's PLY importer by the file's first bytes.
+  if (lower_ext != ".stl" && lower_ext != ".obj") checkPlyHeader(bytes, path);
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, drop_normals ? static_cast<int>(aiComponent_NORMALS) : 0);
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
