@@ -229,5 +229,53 @@ TEST(FuzzRegression, PlyWithoutEndHeaderIsAnInputError) {
   }
 }
 
+// fuzz_mesh (tests/fuzz_corpus/mesh/assimp_assert.ply.bin): a PLY whose vertex and face lines
+// do not match its header. assimp's triangulation reached an internal check (ai_assert), which
+// Debian's build keeps on and which aborted the process; mesh.cpp now makes it an exception.
+const std::string kPlyThatFailsAnAssimpCheck(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x         \n"
+    "property float32 y         \n"
+    "property float32 z         \n"
+    "element face 6;            \n"
+    "property list uint8 int32 vertex_index \n"
+    "end_header\n"
+    "0 0 0\xfe\xff\xff\xff 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\n"
+    "4 0 5\n"
+    "v 0.5 0.5 -0.5\n"
+    "v 0.5 0.5 0.5\n"
+    "\n"
+    "# Point/Line/Face list\n"
+    "\n"
+    "usemtl Default\n"
+    "f 4 3 2 1\n"
+    "f 2 6 5 1\n"
+    "f 3 7 6 2\n"
+    "f 8 7 3 4\n"
+    "f 5 8 4 11 2 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4$clr.ambi 5!1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyThatFailsAnAssimpCheckIsAnInputError) {
+  ASSERT_EQ(kPlyThatFailsAnAssimpCheck.size(), 458u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyThatFailsAnAssimpCheck), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a readable mesh"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vkpose

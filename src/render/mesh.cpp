@@ -9,6 +9,7 @@
 #include <fstream>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <string_view>
 
 #include <assimp/Importer.hpp>
@@ -17,6 +18,17 @@
 #include <fmt/format.h>
 
 #include "vkpose/error.hpp"
+
+// assimp 5.2 as Debian builds it keeps its internal checks (ai_assert) on, and their handler
+// aborts the process: a PLY whose face list does not match its header reaches one in the
+// triangulation step (fuzz_mesh). assimp calls the handler through its PLT, so this
+// definition replaces it for the process and turns a failed check into an exception, which
+// assimp's Importer::ReadFile catches and reports as a failed import (an InputError below).
+namespace Assimp {
+void aiAssertViolation(const char* failed, const char* file, int line) {
+  throw std::runtime_error(fmt::format("assimp's internal check '{}' failed ({}:{})", failed, file, line));
+}
+}  // namespace Assimp
 
 namespace vkpose {
 
