@@ -269,11 +269,47 @@ const std::string kPlyThatFailsAnAssimpCheck(
 
 TEST(FuzzRegression, PlyThatFailsAnAssimpCheckIsAnInputError) {
   ASSERT_EQ(kPlyThatFailsAnAssimpCheck.size(), 458u);
+  // As found, the PLY header check now refuses it first ("element face 6;" has no count).
+  EXPECT_THROW(loadMesh(writeInput("mesh.ply", kPlyThatFailsAnAssimpCheck), MeshUnits::Auto), InputError);
+  // With that line mended it passes the header check and reaches assimp's check still.
+  std::string mended = kPlyThatFailsAnAssimpCheck;
+  mended.replace(mended.find("face 6;"), 7, "face 6 ");
   try {
-    loadMesh(writeInput("mesh.ply", kPlyThatFailsAnAssimpCheck), MeshUnits::Auto);
+    loadMesh(writeInput("mended.ply", mended), MeshUnits::Auto);
     ADD_FAILURE() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("not a readable mesh"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("internal check"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/element_without_count.ply.bin): an element line whose
+// digits run into its name, with no count. assimp read some count of its own from it and
+// asked for 23 GB; loadMesh now refuses an element line that is not 'element NAME COUNT'.
+const std::string kPlyElementWithoutCount(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element 8888888888888888888888888888888888888888888888888888888888888888888888888888888888"
+    "88888888888888888888verrtex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 " + std::string(23, '\x10') + "1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 6 5 4\n"
+    "4 0 4 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyElementWithoutCountIsAnInputError) {
+  ASSERT_EQ(kPlyElementWithoutCount.size(), 276u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyElementWithoutCount), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not 'element NAME COUNT'"), std::string::npos) << e.what();
   }
 }
 

@@ -128,6 +128,9 @@ TEST(MeshLoading, PlyHeadersThatCannotHoldTheirDataAreRefused) {
   EXPECT_NE(error("many_faces.ply", ascii + vertices + many_faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
                 .find("declares 50000000 'face'"),
             std::string::npos);
+  EXPECT_NE(error("huge.ply", ascii + "element vertex 99999999999999999999999\nproperty float x\nend_header\n0\n")
+                .find("not 'element NAME COUNT'"),
+            std::string::npos);
   // Binary: 3 floats a vertex, so 35 bytes cannot hold 3 vertices and a 13-byte face.
   std::string data(3 * 12 + 13, '\0');
   EXPECT_NE(error("short_bin.ply", binary + vertices + faces + "end_header\n" + data.substr(0, 35)).find("declares"),

@@ -16,6 +16,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "vkpose/error.hpp"
 
@@ -186,15 +187,28 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
     if (!nextLine(t))
       throw InputError(fmt::format("{}: the PLY header has no end_header line (a truncated or corrupt file)", path));
     if (!t.empty() && t[0] == "end_header") break;
-    if (!understood || t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
     if (t[0] == "format" && t.size() >= 2) {
       ascii = t[1] == "ascii";
       known_format = ascii || t[1] == "binary_little_endian" || t[1] == "binary_big_endian";
-    } else if (t[0] == "element" && t.size() == 3 && known_format) {
-      Element e{t[1]};
-      const char* end = t[2].data() + t[2].size();
-      understood = std::from_chars(t[2].data(), end, e.count).ptr == end;
+    } else if (t[0] == "element") {
+      // A count assimp would read some other way (fuzz_mesh: digits run into the name, and
+      // no count) is refused rather than left to it: it allocated 23 GB for one.
+      Element e;
+      bool counted = t.size() == 3;
+      if (counted) {
+        const char* end = t[2].data() + t[2].size();
+        const auto [ptr, ec] = std::from_chars(t[2].data(), end, e.count);
+        counted = ec == std::errc{} && ptr == end;
+      }
+      if (!counted)
+        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path,
+                                     fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
+      e.name = t[1];
+      understood = understood && known_format;
       elements.push_back(e);
+    } else if (!understood) {
+      continue;  // the counts are left to assimp; only end_header and element lines matter now
     } else if (t[0] == "property" && !elements.empty()) {
       // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
       // count at least (it may be empty).
