@@ -97,7 +97,7 @@ TEST(MeshLoading, BadFilesGiveClearErrors) {
   EXPECT_THROW(parseMeshUnits("cm"), InputError);
 }
 
-// assimp 5.2 hangs on these instead of failing (fuzz_mesh found the first): loadMesh reads
+// assimp 5.2 hangs or crashes on these instead of failing (fuzz_mesh found several): loadMesh reads
 // the PLY header first and refuses them at once. The same headers with their data load.
 TEST(MeshLoading, PlyHeadersThatCannotHoldTheirDataAreRefused) {
   auto error = [](const std::string& name, const std::string& text) {
@@ -130,6 +130,13 @@ TEST(MeshLoading, PlyHeadersThatCannotHoldTheirDataAreRefused) {
             std::string::npos);
   EXPECT_NE(error("huge.ply", ascii + "element vertex 99999999999999999999999\nproperty float x\nend_header\n0\n")
                 .find("not 'element NAME COUNT'"),
+            std::string::npos);
+  // ASCII: each line one instance, as assimp reads it.
+  EXPECT_NE(error("short_line.ply", ascii + vertices + faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n")
+                .find("line 13 ('4 0 1 2') is not one 'face' element"),
+            std::string::npos);
+  EXPECT_NE(error("split.ply", ascii + vertices + faces + "end_header\n0 0\n0\n1 0 0\n0 1 0\n3 0 1 2\n")
+                .find("is not one 'vertex' element"),
             std::string::npos);
   // Binary: 3 floats a vertex, so 35 bytes cannot hold 3 vertices and a 13-byte face.
   std::string data(3 * 12 + 13, '\0');

@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -142,7 +141,7 @@ std::vector<char> readFile(const std::string& path) {
 }
 
 /// The bytes of a PLY scalar type; 0 for a name this check does not know.
-std::size_t plyScalarBytes(const std::string& type) {
+std::size_t plyScalarBytes(std::string_view type) {
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
   if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
@@ -151,12 +150,13 @@ std::size_t plyScalarBytes(const std::string& type) {
   return 0;
 }
 
-/// Refuses two kinds of PLY on which assimp 5.2 hangs instead of failing, both found by
+/// Refuses kinds of PLY on which assimp 5.2 hangs or crashes instead of failing, found by
 /// fuzz_mesh: a header without its end_header line (assimp loops at the end of the file for
-/// ever), and a header declaring more element instances than the data after it can hold
-/// (assimp sizes its arrays and loops by the declared counts before it finds the data
-/// missing: 100 bytes declaring 50 million vertices take 600 MB and half a minute). A header
-/// line this check does not understand leaves the counts to assimp.
+/// ever), an element line without a count, a header declaring more element instances than
+/// the data after it can hold (assimp sizes its arrays and loops by the declared counts
+/// before it finds the data missing: 100 bytes declaring 50 million vertices take 600 MB and
+/// half a minute), and ASCII data whose lines do not match the header. A header line this
+/// check does not understand leaves the counts and the data to assimp.
 void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
   const std::string_view text(bytes.data(), bytes.size());
   // assimp's own test: the first three bytes, in any case.
@@ -164,24 +164,34 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
       std::tolower(static_cast<unsigned char>(text[1])) != 'l' ||
       std::tolower(static_cast<unsigned char>(text[2])) != 'y')
     return;
-  std::size_t pos = 0;
-  auto nextLine = [&](std::vector<std::string>& tokens) {
+  std::size_t pos = 0, line_number = 0;
+  auto nextLine = [&](std::vector<std::string_view>& tokens) {
     if (pos >= text.size()) return false;
     const std::size_t end = std::min(text.find('\n', pos), text.size());
-    std::istringstream in{std::string(text.substr(pos, end - pos))};
     tokens.clear();
-    for (std::string t; in >> t;) tokens.push_back(t);
+    for (std::size_t i = pos; i < end;) {
+      if (std::isspace(static_cast<unsigned char>(text[i]))) {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j < end && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      tokens.push_back(text.substr(i, j - i));
+      i = j;
+    }
     pos = end + 1;
+    ++line_number;
     return true;
   };
   struct Element {
     std::string name;
     uint64_t count = 0;
-    uint64_t least = 0;  // bytes (binary) or values (ASCII) one instance takes at least
+    uint64_t least = 0;       // bytes (binary) or values (ASCII) one instance takes at least
+    std::vector<bool> lists;  // per property: a list (a count, then that many values)?
   };
   std::vector<Element> elements;
   bool ascii = false, known_format = false, understood = true;
-  std::vector<std::string> t;
+  std::vector<std::string_view> t;
   nextLine(t);  // the magic line
   for (;;) {
     if (!nextLine(t))
@@ -204,7 +214,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
       if (!counted)
         throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path,
                                      fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
-      e.name = t[1];
+      e.name = std::string(t[1]);
       understood = understood && known_format;
       elements.push_back(e);
     } else if (!understood) {
@@ -216,6 +226,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
       const std::size_t size = plyScalarBytes(list ? t[2] : t[1]);
       understood = (list || t.size() == 3) && size > 0 && (!list || plyScalarBytes(t[3]) > 0);
       elements.back().least += ascii ? 1 : size;
+      elements.back().lists.push_back(list);
     } else {
       understood = false;
     }
@@ -232,6 +243,35 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
                                    path, e.count, e.name, data));
     room -= e.count * e.least;
   }
+  if (!ascii) return;
+  // assimp reads an ASCII instance from each line, and a line with fewer values than a
+  // list's count makes it read face indices that are not there (fuzz_mesh: an invalid read
+  // in a post-processing step). Every instance must be one line of exactly its values.
+  for (const Element& e : elements)
+    for (uint64_t i = 0; i < e.count; ++i) {
+      if (!nextLine(t))
+        throw InputError(fmt::format("{}: the PLY data ends after {} of its {} '{}' elements", path, i, e.count, e.name));
+      std::size_t k = 0;
+      bool whole = true;
+      for (const bool list : e.lists) {
+        if (k >= t.size()) {
+          whole = false;
+          break;
+        }
+        uint64_t n = 0;
+        if (list) {
+          const auto [ptr, ec] = std::from_chars(t[k].data(), t[k].data() + t[k].size(), n);
+          if (ec != std::errc{} || ptr != t[k].data() + t[k].size() || n > t.size() - k - 1) {
+            whole = false;
+            break;
+          }
+        }
+        k += 1 + n;
+      }
+      if (!whole || k != t.size())
+        throw InputError(fmt::format("{}: line {} ('{}') is not one '{}' element as the PLY header declares it", path,
+                                     line_number, fmt::format("{}", fmt::join(t, " ")).substr(0, 60), e.name));
+    }
 }
 }  // namespace
 
