@@ -405,5 +405,52 @@ TEST(FuzzRegression, PlyWithAShortFaceLineIsAnInputError) {
   }
 }
 
+// fuzz_mesh (tests/fuzz_corpus/mesh/malformed_property.ply.bin): property lines run into one
+// another ('property float32element'). assimp read the header its own way and then wild
+// memory; loadMesh now refuses a property line that is not 'property TYPE NAME' or a list.
+const std::string kPlyMalformedProperty(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x            \n"
+    "property float32 x         \n"
+    "property float32element   \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_indperty float32 x         \n"
+    "property float32element   \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\xf6\xcb\xdf\xcf\xdf\xce\xdf\xcb 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4 5 132 vertex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3.obj 7 4 0\n");
+
+TEST(FuzzRegression, PlyWithAMalformedPropertyLineIsAnInputError) {
+  ASSERT_EQ(kPlyMalformedProperty.size(), 518u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyMalformedProperty), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reads 'property float32element'"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vkpose

@@ -141,7 +141,9 @@ std::vector<char> readFile(const std::string& path) {
 }
 
 /// The bytes of a PLY scalar type; 0 for a name this check does not know.
-std::size_t plyScalarBytes(std::string_view type) {
+std::size_t plyScalarBytes(std::string_view name) {
+  std::string type(name);  // assimp reads the type names in any case
+  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char ch) { return std::tolower(ch); });
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
   if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
@@ -152,11 +154,11 @@ std::size_t plyScalarBytes(std::string_view type) {
 
 /// Refuses kinds of PLY on which assimp 5.2 hangs or crashes instead of failing, found by
 /// fuzz_mesh: a header without its end_header line (assimp loops at the end of the file for
-/// ever), an element line without a count, a header declaring more element instances than
+/// ever), a malformed element or property line, a header declaring more element instances than
 /// the data after it can hold (assimp sizes its arrays and loops by the declared counts
 /// before it finds the data missing: 100 bytes declaring 50 million vertices take 600 MB and
-/// half a minute), and ASCII data whose lines do not match the header. A header line this
-/// check does not understand leaves the counts and the data to assimp.
+/// half a minute), and ASCII data whose lines do not match the header. A file without a
+/// format line it knows is left to assimp.
 void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
   const std::string_view text(bytes.data(), bytes.size());
   // assimp's own test: the first three bytes, in any case.
@@ -190,7 +192,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
     std::vector<bool> lists;  // per property: a list (a count, then that many values)?
   };
   std::vector<Element> elements;
-  bool ascii = false, known_format = false, understood = true;
+  bool ascii = false, known_format = false;
   std::vector<std::string_view> t;
   nextLine(t);  // the magic line
   for (;;) {
@@ -215,23 +217,23 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
         throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path,
                                      fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
       e.name = std::string(t[1]);
-      understood = understood && known_format;
       elements.push_back(e);
-    } else if (!understood) {
-      continue;  // the counts are left to assimp; only end_header and element lines matter now
-    } else if (t[0] == "property" && !elements.empty()) {
+    } else if (t[0] == "property") {
       // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
-      // count at least (it may be empty).
+      // count at least (it may be empty). Anything else is refused, as a malformed element
+      // line is: assimp read such a header its own way and then wild memory (fuzz_mesh).
       const bool list = t.size() == 5 && t[1] == "list";
-      const std::size_t size = plyScalarBytes(list ? t[2] : t[1]);
-      understood = (list || t.size() == 3) && size > 0 && (!list || plyScalarBytes(t[3]) > 0);
+      const std::size_t size = t.size() == 3 || list ? plyScalarBytes(list ? t[2] : t[1]) : 0;
+      if (elements.empty() || size == 0 || (list && plyScalarBytes(t[3]) == 0))
+        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'property TYPE NAME' or 'property list "
+                                     "COUNT_TYPE TYPE NAME' of an element",
+                                     path, fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
       elements.back().least += ascii ? 1 : size;
       elements.back().lists.push_back(list);
-    } else {
-      understood = false;
     }
+    // Other lines are skipped, as assimp skips them (Blender once wrote a bare text line).
   }
-  if (!understood || !known_format) return;
+  if (!known_format) return;
   // ASCII: n values of a character each need n - 1 separators too, so n <= (bytes + 1) / 2.
   const uint64_t data = text.size() - std::min(pos, text.size());
   uint64_t room = ascii ? (data + 1) / 2 : data;
