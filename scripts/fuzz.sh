@@ -10,7 +10,7 @@ seconds=${1:-60}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(bank camera scene_gt scene_gt_info scene_camera models_info tejani_poses bop_results mesh)
+  targets=(bank camera scene_gt scene_gt_info scene_camera models_info tejani_poses bop_results mesh config)
 fi
 
 cmake --preset fuzz >/dev/null || exit 1

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -11,10 +12,17 @@
 
 #include "tests/test_support.hpp"
 #include "vkpose/camera.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/mesh.hpp"
 #include "vkpose/template_bank.hpp"
 #include "vkpose/views.hpp"
+
+// assimp's handler of its failed internal checks, which src/render/mesh.cpp defines.
+namespace Assimp {
+void aiAssertViolation(const char* failed, const char* file, int line);
+}  // namespace Assimp
 
 namespace vkpose {
 namespace {
@@ -151,6 +159,297 @@ TEST(FuzzRegression, BankWithANanViewRangeIsAnInputError) {
   p = {};
   p.radii = {0.5f, 6.f, 1e-9f};  // 5.5e9 values: refused before listing them
   EXPECT_THROW(validateViewSampling(p), InputError);
+}
+
+
+// fuzz_config (the seed tests/fuzz_corpus/config/wrong_types.json): a number no double holds.
+// nlohmann::json reports it as out_of_range, not parse_error, and parseConfig let it escape.
+TEST(FuzzRegression, ConfigWithANumberOverflowIsAnInputError) {
+  const std::string bytes = "{\"nms\": {\"radius_px\": \"3\"}, \"verify\": {\"threshold\": 1e400}}\n";
+  try {
+    loadConfig(writeInput("overflow.json", bytes));
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a JSON config file"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_config's read-back check (found by hand, with an input written for it): a float just
+// below FLT_MAX prints as 3.4028235e+38, which read back as a double is above FLT_MAX, and
+// parseConfig refused what configJson (vkpose config --check) had printed.
+TEST(FuzzRegression, ConfigNearFloatMaxReadsBackAsPrinted) {
+  const DetectorParams p = parseConfig(R"({"score": {"depth_unit_m": 3.4028234e38}})", "big.json");
+  EXPECT_EQ(p.score.depth_unit_m, std::numeric_limits<float>::max());
+  const std::string printed = configJson(p);
+  EXPECT_EQ(configJson(parseConfig(printed, "printed.json")), printed);
+  EXPECT_THROW(parseConfig(R"({"score": {"depth_unit_m": 3.5e38}})", "inf.json"), InputError) << "no float holds it";
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/no_end_header.ply.bin, whose first byte picked .ply): a
+// PLY whose end_header line is damaged. assimp 5.2 loops for ever looking for it; loadMesh
+// now refuses the header first.
+const std::string kPlyWithoutEndHeader(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x         \n"
+    "property float32 y         \n"
+    "property float32 z         \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_index \n"
+    "end\x99"
+    "header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\n"
+    "4 0 5\n"
+    "v 0.5 0.5 -0.5\n"
+    "v 0.5 0.5 0.5\n"
+    "\n"
+    "# Point/Line/Face list\n"
+    "\n"
+    "usemtl Default\n"
+    "f 4 3 2 1\n"
+    "f 2 6 5 1\n"
+    "f 3 7 6 2\n"
+    "f 8 7 3 4\n"
+    "f 5 8 4 11 2 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4$clr.ambi 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyWithoutEndHeaderIsAnInputError) {
+  ASSERT_EQ(kPlyWithoutEndHeader.size(), 458u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyWithoutEndHeader), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no end_header line"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/assimp_assert.ply.bin): a PLY whose vertex and face lines
+// do not match its header. assimp's triangulation reached an internal check (ai_assert), which
+// Debian's build keeps on and which aborted the process; mesh.cpp now makes it an exception.
+const std::string kPlyThatFailsAnAssimpCheck(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x         \n"
+    "property float32 y         \n"
+    "property float32 z         \n"
+    "element face 6;            \n"
+    "property list uint8 int32 vertex_index \n"
+    "end_header\n"
+    "0 0 0\xfe\xff\xff\xff 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\n"
+    "4 0 5\n"
+    "v 0.5 0.5 -0.5\n"
+    "v 0.5 0.5 0.5\n"
+    "\n"
+    "# Point/Line/Face list\n"
+    "\n"
+    "usemtl Default\n"
+    "f 4 3 2 1\n"
+    "f 2 6 5 1\n"
+    "f 3 7 6 2\n"
+    "f 8 7 3 4\n"
+    "f 5 8 4 11 2 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4$clr.ambi 5!1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyThatFailsAnAssimpCheckIsAnInputError) {
+  ASSERT_EQ(kPlyThatFailsAnAssimpCheck.size(), 458u);
+  // The PLY header and data checks in mesh.cpp now refuse it before assimp sees it.
+  EXPECT_THROW(loadMesh(writeInput("mesh.ply", kPlyThatFailsAnAssimpCheck), MeshUnits::Auto), InputError);
+  // What still reaches an assimp check throws instead of aborting (mesh.cpp's handler).
+  EXPECT_THROW(Assimp::aiAssertViolation("fuzz", __FILE__, __LINE__), std::runtime_error);
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/element_without_count.ply.bin): an element line whose
+// digits run into its name, with no count. assimp read some count of its own from it and
+// asked for 23 GB; loadMesh now refuses an element line that is not 'element NAME COUNT'.
+const std::string kPlyElementWithoutCount(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element 8888888888888888888888888888888888888888888888888888888888888888888888888888888888"
+    "88888888888888888888verrtex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 " + std::string(23, '\x10') + "1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 6 5 4\n"
+    "4 0 4 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n");
+
+TEST(FuzzRegression, PlyElementWithoutCountIsAnInputError) {
+  ASSERT_EQ(kPlyElementWithoutCount.size(), 276u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyElementWithoutCount), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not 'element NAME COUNT'"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/short_face_line.ply.bin): an ASCII face line '4 0 5'
+// (four indices declared, two given). assimp read indices that were not there and a
+// post-processing step read wild memory; loadMesh now checks each ASCII line against the
+// header.
+const std::string kPlyShortFaceLine(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x         \n"
+    "property float32 y         \n"
+    "property float32 z         \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\n"
+    "4 0 5\n"
+    "v 0.5 0.5 -0.5\n"
+    "v 0.5 0.5 0.5\n"
+    "\n"
+    "# Poi\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "\n"
+    "nt/Line/Face list\n"
+    "\n"
+    "usemtl Default\n"
+    "f 4 3 2 1\n"
+    "f 2 6 5 1\n"
+    "f 3 7 6 2\n"
+    "f 8 7 3 4\n"
+    "f 5 8 4 11 2 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4$clr.ambi\0 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3\n"
+    "4 3 7 4 0\n",
+    501);
+
+TEST(FuzzRegression, PlyWithAShortFaceLineIsAnInputError) {
+  ASSERT_EQ(kPlyShortFaceLine.size(), 501u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyShortFaceLine), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("('4 0 5') is not one 'face' element"), std::string::npos) << e.what();
+  }
+}
+
+// fuzz_mesh (tests/fuzz_corpus/mesh/malformed_property.ply.bin): property lines run into one
+// another ('property float32element'). assimp read the header its own way and then wild
+// memory; loadMesh now refuses a property line that is not 'property TYPE NAME' or a list.
+const std::string kPlyMalformedProperty(
+    "ply\n"
+    "format ascii 1.0          \n"
+    "element vertex 8          \n"
+    "property float32 x            \n"
+    "property float32 x         \n"
+    "property float32element   \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_indperty float32 x         \n"
+    "property float32element   \n"
+    "element face 6             \n"
+    "property list uint8 int32 vertex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 1\n"
+    "1 1 0\xf6\xcb\xdf\xcf\xdf\xce\xdf\xcb 3\n"
+    "4 7 6 5 4\n"
+    "4 0 4 5 132 vertex_index \n"
+    "end_header\n"
+    "0 0 0\n"
+    "0 0 1\n"
+    "0 1 1\n"
+    "0 1 0\n"
+    "1 0 0\n"
+    "1 0 1\n"
+    "1 1 5 1\n"
+    "4 1 5 6 2\n"
+    "4 2 6 7 3.obj 7 4 0\n");
+
+TEST(FuzzRegression, PlyWithAMalformedPropertyLineIsAnInputError) {
+  ASSERT_EQ(kPlyMalformedProperty.size(), 518u);
+  try {
+    loadMesh(writeInput("mesh.ply", kPlyMalformedProperty), MeshUnits::Auto);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reads 'property float32element'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

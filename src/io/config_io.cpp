@@ -106,7 +106,10 @@ void assign(const ConfigField& f, const json& v, const std::string& where) {
         } else if constexpr (std::is_floating_point_v<T>) {
           if (!v.is_number()) throw InputError(fmt::format("{} must be a number, not {}", name, v.dump()));
           const double d = v.get<double>();
-          if (!std::isfinite(d) || std::abs(d) > static_cast<double>(std::numeric_limits<T>::max()))
+          // Whether the field's type holds it once rounded, not whether d <= max: configJson
+          // prints a float's shortest form, which for values near FLT_MAX reads back a little
+          // above it (3.4028235e+38), and that must load again.
+          if (!std::isfinite(d) || !std::isfinite(static_cast<T>(d)))
             throw InputError(fmt::format("{} must be a finite number, not {}", name, v.dump()));
           *field = static_cast<T>(d);
         } else {
@@ -151,19 +154,26 @@ DetectorParams parseConfig(const std::string& text, const std::string& source, c
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error for bad syntax, out_of_range for a number no double holds (1e400).
     throw InputError(fmt::format("{}: not a JSON config file ({})", source, e.what()));
   }
   if (!doc.is_object()) throw InputError(fmt::format("{}: a config file is a JSON object of sections", source));
   DetectorParams p = base;
   std::vector<ConfigField> fields = configFields(p);
-  for (const auto& [section, keys] : doc.items()) {
+  // Plain names, not structured bindings: clang 14 (the fuzz preset) cannot capture those in
+  // the lambdas below.
+  for (const auto& entry : doc.items()) {
+    const std::string& section = entry.key();
+    const json& keys = entry.value();
     if (std::none_of(fields.begin(), fields.end(), [&](const ConfigField& f) { return f.section == section; }))
       throw InputError(
           fmt::format("{}: unknown section \"{}\" (see vkpose config --print-defaults)", source, section));
     if (!keys.is_object())
       throw InputError(fmt::format("{}: \"{}\" must be an object of parameters", source, section));
-    for (const auto& [key, value] : keys.items()) {
+    for (const auto& item : keys.items()) {
+      const std::string& key = item.key();
+      const json& value = item.value();
       const auto it = std::find_if(fields.begin(), fields.end(),
                                    [&](const ConfigField& f) { return f.section == section && f.key == key; });
       if (it == fields.end()) {

@@ -1,17 +1,34 @@
 #include "vkpose/mesh.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <stdexcept>
+#include <string_view>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "vkpose/error.hpp"
+
+// assimp 5.2 as Debian builds it keeps its internal checks (ai_assert) on, and their handler
+// aborts the process: a PLY whose face list does not match its header reaches one in the
+// triangulation step (fuzz_mesh). assimp calls the handler through its PLT, so this
+// definition replaces it for the process and turns a failed check into an exception, which
+// assimp's Importer::ReadFile catches and reports as a failed import (an InputError below).
+namespace Assimp {
+void aiAssertViolation(const char* failed, const char* file, int line) {
+  throw std::runtime_error(fmt::format("assimp's internal check '{}' failed ({}:{})", failed, file, line));
+}
+}  // namespace Assimp
 
 namespace vkpose {
 
@@ -122,6 +139,142 @@ std::vector<char> readFile(const std::string& path) {
   if (bytes.empty()) throw InputError(fmt::format("{}: the mesh file is empty", path));
   return bytes;
 }
+
+/// The bytes of a PLY scalar type; 0 for a name this check does not know.
+std::size_t plyScalarBytes(std::string_view name) {
+  std::string type(name);  // assimp reads the type names in any case
+  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+/// Refuses kinds of PLY on which assimp 5.2 hangs or crashes instead of failing, found by
+/// fuzz_mesh: a header without its end_header line (assimp loops at the end of the file for
+/// ever), a malformed element or property line, a header declaring more element instances than
+/// the data after it can hold (assimp sizes its arrays and loops by the declared counts
+/// before it finds the data missing: 100 bytes declaring 50 million vertices take 600 MB and
+/// half a minute), and ASCII data whose lines do not match the header. A file without a
+/// format line it knows is left to assimp.
+void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
+  const std::string_view text(bytes.data(), bytes.size());
+  // assimp's own test: the first three bytes, in any case.
+  if (text.size() < 3 || std::tolower(static_cast<unsigned char>(text[0])) != 'p' ||
+      std::tolower(static_cast<unsigned char>(text[1])) != 'l' ||
+      std::tolower(static_cast<unsigned char>(text[2])) != 'y')
+    return;
+  std::size_t pos = 0, line_number = 0;
+  auto nextLine = [&](std::vector<std::string_view>& tokens) {
+    if (pos >= text.size()) return false;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    tokens.clear();
+    for (std::size_t i = pos; i < end;) {
+      if (std::isspace(static_cast<unsigned char>(text[i]))) {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j < end && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      tokens.push_back(text.substr(i, j - i));
+      i = j;
+    }
+    pos = end + 1;
+    ++line_number;
+    return true;
+  };
+  struct Element {
+    std::string name;
+    uint64_t count = 0;
+    uint64_t least = 0;       // bytes (binary) or values (ASCII) one instance takes at least
+    std::vector<bool> lists;  // per property: a list (a count, then that many values)?
+  };
+  std::vector<Element> elements;
+  bool ascii = false, known_format = false;
+  std::vector<std::string_view> t;
+  nextLine(t);  // the magic line
+  for (;;) {
+    if (!nextLine(t))
+      throw InputError(fmt::format("{}: the PLY header has no end_header line (a truncated or corrupt file)", path));
+    if (!t.empty() && t[0] == "end_header") break;
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "format" && t.size() >= 2) {
+      ascii = t[1] == "ascii";
+      known_format = ascii || t[1] == "binary_little_endian" || t[1] == "binary_big_endian";
+    } else if (t[0] == "element") {
+      // A count assimp would read some other way (fuzz_mesh: digits run into the name, and
+      // no count) is refused rather than left to it: it allocated 23 GB for one.
+      Element e;
+      bool counted = t.size() == 3;
+      if (counted) {
+        const char* end = t[2].data() + t[2].size();
+        const auto [ptr, ec] = std::from_chars(t[2].data(), end, e.count);
+        counted = ec == std::errc{} && ptr == end;
+      }
+      if (!counted)
+        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path,
+                                     fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
+      e.name = std::string(t[1]);
+      elements.push_back(e);
+    } else if (t[0] == "property") {
+      // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
+      // count at least (it may be empty). Anything else is refused, as a malformed element
+      // line is: assimp read such a header its own way and then wild memory (fuzz_mesh).
+      const bool list = t.size() == 5 && t[1] == "list";
+      const std::size_t size = t.size() == 3 || list ? plyScalarBytes(list ? t[2] : t[1]) : 0;
+      if (elements.empty() || size == 0 || (list && plyScalarBytes(t[3]) == 0))
+        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'property TYPE NAME' or 'property list "
+                                     "COUNT_TYPE TYPE NAME' of an element",
+                                     path, fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
+      elements.back().least += ascii ? 1 : size;
+      elements.back().lists.push_back(list);
+    }
+    // Other lines are skipped, as assimp skips them (Blender once wrote a bare text line).
+  }
+  if (!known_format) return;
+  // ASCII: n values of a character each need n - 1 separators too, so n <= (bytes + 1) / 2.
+  const uint64_t data = text.size() - std::min(pos, text.size());
+  uint64_t room = ascii ? (data + 1) / 2 : data;
+  for (const Element& e : elements) {
+    if (e.least == 0) continue;
+    if (e.count > room / e.least)
+      throw InputError(fmt::format("{}: the PLY header declares {} '{}' elements, more than the {} bytes after the "
+                                   "header can hold (a truncated or corrupt file)",
+                                   path, e.count, e.name, data));
+    room -= e.count * e.least;
+  }
+  if (!ascii) return;
+  // assimp reads an ASCII instance from each line, and a line with fewer values than a
+  // list's count makes it read face indices that are not there (fuzz_mesh: an invalid read
+  // in a post-processing step). Every instance must be one line of exactly its values.
+  for (const Element& e : elements)
+    for (uint64_t i = 0; i < e.count; ++i) {
+      if (!nextLine(t))
+        throw InputError(fmt::format("{}: the PLY data ends after {} of its {} '{}' elements", path, i, e.count, e.name));
+      std::size_t k = 0;
+      bool whole = true;
+      for (const bool list : e.lists) {
+        if (k >= t.size()) {
+          whole = false;
+          break;
+        }
+        uint64_t n = 0;
+        if (list) {
+          const auto [ptr, ec] = std::from_chars(t[k].data(), t[k].data() + t[k].size(), n);
+          if (ec != std::errc{} || ptr != t[k].data() + t[k].size() || n > t.size() - k - 1) {
+            whole = false;
+            break;
+          }
+        }
+        k += 1 + n;
+      }
+      if (!whole || k != t.size())
+        throw InputError(fmt::format("{}: line {} ('{}') is not one '{}' element as the PLY header declares it", path,
+                                     line_number, fmt::format("{}", fmt::join(t, " ")).substr(0, 60), e.name));
+    }
+}
 }  // namespace
 
 Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) {
@@ -133,6 +286,9 @@ Mesh loadMesh(const std::string& path, MeshUnits units, MeshLoadReport* report) 
   std::string lower_ext = ext;
   std::transform(lower_ext.begin(), lower_ext.end(), lower_ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
   const bool drop_normals = lower_ext == ".stl";
+  // The STL and OBJ importers, which assimp picks by these extensions, never read a file as
+  // PLY; any other name may reach assimp's PLY importer by the file's first bytes.
+  if (lower_ext != ".stl" && lower_ext != ".obj") checkPlyHeader(bytes, path);
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, drop_normals ? static_cast<int>(aiComponent_NORMALS) : 0);
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
