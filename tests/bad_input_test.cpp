@@ -70,11 +70,7 @@ std::string readFile(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-/// `f` throws an InputError whose message holds every one of `parts`.
-void expectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
-  const std::string message = test::inputErrorOf(f);
-  for (const auto& p : parts) EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' missing from: " << message;
-}
+using test::expectInputError;
 
 /// A bank of one template on a 5 cm cube, made in code (no training): small and CPU-only.
 TemplateBank tinyBank() {

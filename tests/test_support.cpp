@@ -102,4 +102,9 @@ std::string inputErrorOf(const std::function<void()>& f) {
   return {};
 }
 
+void expectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
+  const std::string message = inputErrorOf(f);
+  for (const auto& p : parts) EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' missing from: " << message;
+}
+
 }  // namespace vkpose::test

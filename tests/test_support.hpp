@@ -2,6 +2,7 @@
 // Shared helpers of the test suites: the real frames in ../shared/data, skipping with a
 // clear message when it is absent, and LINEMOD templates cut from a frame.
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,8 @@ std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const Feat
 
 /// The message of the InputError `f` throws; fails the test when it throws nothing.
 std::string inputErrorOf(const std::function<void()>& f);
+/// `f` throws an InputError whose message holds every one of `parts`.
+void expectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts);
 
 /// A bank trained from `mesh` with `params`, cached in VKPOSE_TEST_CACHE_DIR between runs
 /// under its training key (bank_cache.hpp; training takes about a minute per object on 2
