@@ -141,13 +141,23 @@ void runSoak(const SoakOptions& o, const GlobalOptions& global) {
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double end = residentMiB();
   const double growth = end - start;
-  fmt::print("end: VmRSS {:.1f} MiB, growth {:+.1f} MiB (bound {:.0f} MiB), peak {:.1f} MiB; {} frames in {:.1f} s "
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer holds freed memory in quarantine and maps shadow memory as it goes: the
+  // resident size swings by a gigabyte from frame to frame and says nothing about leaks, which
+  // LeakSanitizer reports at exit instead. The bound is printed, not enforced.
+  constexpr bool kEnforceBound = false;
+  const char* bound_note = ", not enforced under AddressSanitizer";
+#else
+  constexpr bool kEnforceBound = true;
+  const char* bound_note = "";
+#endif
+  fmt::print("end: VmRSS {:.1f} MiB, growth {:+.1f} MiB (bound {:.0f} MiB{}), peak {:.1f} MiB; {} frames in {:.1f} s "
              "({:.0f} ms a frame)\n",
-             end, growth, o.max_growth_mib, peak, o.frames, total_s, 1000.0 * total_s / o.frames);
+             end, growth, o.max_growth_mib, bound_note, peak, o.frames, total_s, 1000.0 * total_s / o.frames);
   fmt::print("deterministic: {}\n",
              nondeterministic.empty() ? "yes" : fmt::format("no ({} of {} frames differ; first: {})", differing,
                                                             o.frames, nondeterministic));
-  if (growth > o.max_growth_mib)
+  if (kEnforceBound && growth > o.max_growth_mib)
     throw std::runtime_error(fmt::format("soak failed: resident memory grew by {:.1f} MiB over {} frames (bound {} MiB)",
                                          growth, o.frames, o.max_growth_mib));
   if (!nondeterministic.empty()) throw std::runtime_error("soak failed: the detections differ between runs");
