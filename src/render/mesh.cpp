@@ -191,6 +191,10 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
     uint64_t least = 0;       // bytes (binary) or values (ASCII) one instance takes at least
     std::vector<bool> lists;  // per property: a list (a count, then that many values)?
   };
+  // A refused header line as the error message quotes it: its tokens, at most 60 characters.
+  const auto quoted = [](const std::vector<std::string_view>& tokens) {
+    return fmt::format("{}", fmt::join(tokens, " ")).substr(0, 60);
+  };
   std::vector<Element> elements;
   bool ascii = false, known_format = false;
   std::vector<std::string_view> t;
@@ -214,8 +218,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
         counted = ec == std::errc{} && ptr == end;
       }
       if (!counted)
-        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path,
-                                     fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
+        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path, quoted(t)));
       e.name = std::string(t[1]);
       elements.push_back(e);
     } else if (t[0] == "property") {
@@ -227,7 +230,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
       if (elements.empty() || size == 0 || (list && plyScalarBytes(t[3]) == 0))
         throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'property TYPE NAME' or 'property list "
                                      "COUNT_TYPE TYPE NAME' of an element",
-                                     path, fmt::format("{}", fmt::join(t, " ")).substr(0, 60)));
+                                     path, quoted(t)));
       elements.back().least += ascii ? 1 : size;
       elements.back().lists.push_back(list);
     }
