@@ -1,50 +1,65 @@
 #version 450
 // Stage 2, coarse level: every template (workgroup row y) at every cell position of its
 // range (match::coarseRange); positions over the template's raw threshold are
-// appended to the candidate list. An invocation scores ROWS rows of 16 positions, so each
-// feature's offset is read once for them.
+// appended to the candidate list. An invocation scores ROWS rows of SPAN blocks of 16
+// positions: per row and feature SPAN + 1 texels, where a lane per block would fetch two
+// each (the fetches are what the pass costs on llvmpipe).
 #include "similarity_common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = 16) in;  // kCoarseGroup in similarity_gpu.cpp
 layout(std430, binding = 3) buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(push_constant) uniform Push {
   int template_base;  // global id of this chunk's first template
-  int stride;         // bytes per linear-memory row
+  int stride;         // bytes per linear-memory row (a multiple of 16)
   uint capacity;      // candidate slots
 } pc;
-const int ROWS = 4;  // match kCoarseRows in similarity_gpu.cpp
+const int ROWS = 2;  // match kCoarseRows in similarity_gpu.cpp
+const int SPAN = 3;  // match kCoarseSpan in similarity_gpu.cpp
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
   int t = int(gl_WorkGroupID.y);
   int h = t * HEADER_INTS;
   // This template's own range of positions (match::coarseRange): columns, rows.
   int columns = headers[h + 5], rows = headers[h + 6];
-  int blocks = (columns + 15) / 16;
-  if (idx >= (rows + ROWS - 1) / ROWS * blocks) return;
-  int band = idx / blocks;
-  int block = idx - band * blocks;
+  int spans = (columns + 16 * SPAN - 1) / (16 * SPAN);
+  if (idx >= (rows + ROWS - 1) / ROWS * spans) return;
+  int band = idx / spans;
+  int span = idx - band * spans;
   int r0 = headers[h + 3] + band * ROWS;
-  int c0 = headers[h + 2] + block * 16;
+  int c0 = headers[h + 2] + span * 16 * SPAN;
   int f = headers[h], end = f + headers[h + 1];
-  uint base = uint(r0 * pc.stride + c0), stride = uint(pc.stride);
-  uvec4 lo[ROWS], hi[ROWS];
-  for (int r = 0; r < ROWS; ++r) lo[r] = hi[r] = uvec4(0u);
+  uint base = uint(r0 * pc.stride + c0);
+  int row_texels = pc.stride / 16;
+  uvec4 lo[ROWS * SPAN], hi[ROWS * SPAN];
+  for (int i = 0; i < ROWS * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
   while (f < end) {
     int chunk_end = min(f + 63, end);
-    uvec4 acc[ROWS];
-    for (int r = 0; r < ROWS; ++r) acc[r] = uvec4(0u);
+    uvec4 acc[ROWS * SPAN];
+    for (int i = 0; i < ROWS * SPAN; ++i) acc[i] = uvec4(0u);
     for (; f < chunk_end; ++f) {
       uint off = uint(texelFetch(feature_offsets, f).x) + base;
-      for (int r = 0; r < ROWS; ++r) acc[r] += sixteenBytes(off + uint(r) * stride);
-    }
-    for (int r = 0; r < ROWS; ++r) widen(acc[r], lo[r], hi[r]);
-  }
-  uint threshold = uint(headers[h + 4]);
-  for (int r = 0; r < ROWS && band * ROWS + r < rows; ++r)
-    for (int p = 0; p < 16 && block * 16 + p < columns; ++p) {
-      uint score = scoreAt(lo[r], hi[r], p);
-      if (score > threshold) {
-        uint slot = atomicAdd(count, 1u);
-        if (slot < pc.capacity) items[slot] = uvec4(uint(pc.template_base + t), uint(r0 + r), uint(c0 + p), score);
+      // The stride is a multiple of 16, so every row has the same alignment.
+      uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
+      int first = int(off >> 4);
+      for (int r = 0; r < ROWS; ++r) {
+        uvec4 x = texelFetch(memory, first + r * row_texels);
+        for (int k = 0; k < SPAN; ++k) {
+          uvec4 y = texelFetch(memory, first + r * row_texels + k + 1);
+          acc[r * SPAN + k] += alignBytes(x, y, q, s);
+          x = y;
+        }
       }
     }
+    for (int i = 0; i < ROWS * SPAN; ++i) widen(acc[i], lo[i], hi[i]);
+  }
+  uint threshold = uint(headers[h + 4]);
+  for (int r = 0; r < ROWS; ++r)
+    for (int k = 0; k < SPAN; ++k)
+      for (int p = 0; p < 16; ++p) {
+        uint score = scoreAt(lo[r * SPAN + k], hi[r * SPAN + k], p);
+        int column = span * 16 * SPAN + k * 16 + p;
+        if (score > threshold && band * ROWS + r < rows && column < columns) {
+          uint slot = atomicAdd(count, 1u);
+          if (slot < pc.capacity) items[slot] = uvec4(uint(pc.template_base + t), uint(r0 + r), uint(headers[h + 2] + column), score);
+        }
+      }
 }

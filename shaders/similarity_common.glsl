@@ -8,16 +8,19 @@
 layout(binding = 0) uniform utextureBuffer memory;
 layout(binding = 2) uniform itextureBuffer feature_offsets;  // r32i
 
-// The 16 responses at byte offset `off`: two texels, their words picked and funnel-shifted
-// into alignment. The layouts' right and bottom margins keep the second texel inside the
-// buffer.
-uvec4 sixteenBytes(uint off) {
-  uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
-  int t = int(off >> 4);
-  uvec4 x = texelFetch(memory, t), y = texelFetch(memory, t + 1);
+// The 16 bytes at byte `q * 4 + s / 8` of the 32 in texels x, y: their words picked and
+// funnel-shifted into alignment.
+uvec4 alignBytes(uvec4 x, uvec4 y, uint q, uint s) {
   uvec4 a = q == 0u ? x : q == 1u ? uvec4(x.yzw, y.x) : q == 2u ? uvec4(x.zw, y.xy) : uvec4(x.w, y.xyz);
   uint e = q == 0u ? y.x : q == 1u ? y.y : q == 2u ? y.z : y.w;
   return s == 0u ? a : (a >> s) | (uvec4(a.yzw, e) << (32u - s));
+}
+
+// The 16 responses at byte offset `off`: two texels, aligned. The layouts' right and bottom
+// margins keep the second texel inside the buffer.
+uvec4 sixteenBytes(uint off) {
+  int t = int(off >> 4);
+  return alignBytes(texelFetch(memory, t), texelFetch(memory, t + 1), (off >> 2) & 3u, (off & 3u) * 8u);
 }
 
 // Widens packed byte sums into the packed 16-bit totals.

@@ -12,6 +12,9 @@ namespace vkpose::gpu {
 
 namespace {
 constexpr uint32_t kGroup = 64;
+// Zeros after the last plane: the coarse similarity pass fetches whole texels up to 64 bytes
+// past a row's last scanned position, which the bottom margin covers except at the very end.
+constexpr std::size_t kMemoryTailBytes = 64;
 struct SizePush {
   int32_t width, height;
 };
@@ -112,9 +115,9 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     const LinearMemoryLayout& layout = layouts[l];
     const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
                       L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
-                      L.memory.size() == layout.total_bytes();
+                      L.memory.size() == layout.total_bytes() + kMemoryTailBytes;
     if (!same) {
-      L.memory = Buffer(ctx_, layout.total_bytes());
+      L.memory = Buffer(ctx_, layout.total_bytes() + kMemoryTailBytes);
       batch.fill(L.memory, 0u);
       L.layout = layout;
     }

@@ -10,7 +10,12 @@ namespace vkpose::gpu {
 namespace {
 constexpr int kHeaderInts = 8;  // HEADER_INTS in shaders/similarity_common.glsl
 constexpr uint32_t kGroup = 64;
-constexpr int kCoarseRows = 4;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
+constexpr int kCoarseRows = 2;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
+constexpr int kCoarseSpan = 3;  // blocks of 16 positions per coarse invocation: SPAN there
+// Coarse workgroup size (local_size_x there): a template needs about 15 invocations at 640 x
+// 480, and on llvmpipe each idle 8-lane vector of a workgroup still costs a pass through
+// the shader, so 64 would spend most of the time on empty lanes.
+constexpr uint32_t kCoarseGroup = 16;
 constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
 constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
 // State buffer (refine_args.comp): unit count, most units of a chunk, next and this chunk's
@@ -113,7 +118,8 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         if (l + 1 == levels)
           chunk.coarse_invocations = std::max<std::size_t>(
               chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
-                                            static_cast<std::size_t>((range.columns + 15) / 16));
+                                            static_cast<std::size_t>((range.columns + 16 * kCoarseSpan - 1) /
+                                                                     (16 * kCoarseSpan)));
         const int T = layout.T;
         for (const auto& f : level.features)
           offsets[l].push_back(static_cast<int32_t>(
@@ -165,7 +171,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     if (chunk.coarse_invocations > 0)
       batch.dispatch(kernels_->coarse,
                      {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_}, push,
-                     groupsFor(chunk.coarse_invocations, kGroup), static_cast<uint32_t>(chunk.template_count));
+                     groupsFor(chunk.coarse_invocations, kCoarseGroup), static_cast<uint32_t>(chunk.template_count));
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);

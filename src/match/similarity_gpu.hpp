@@ -41,7 +41,7 @@ class Similarity {
  private:
   struct Chunk {
     int first_template = 0, template_count = 0;
-    std::size_t coarse_invocations = 0;  ///< the most any template needs: (rows / 4) x (columns / 16) of its range
+    std::size_t coarse_invocations = 0;  ///< the most any template needs: (rows / 2) x (columns / 48) of its range
     Buffer headers[2], offsets[2];
   };
   struct Kernels;
