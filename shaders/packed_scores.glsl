@@ -1,4 +1,4 @@
-// Scores of 16 consecutive positions in packed 16-bit lanes, as scoreSixteen leaves them:
+// Scores of 16 consecutive positions in packed 16-bit lanes, as the similarity kernels leave them:
 // `lo` holds positions 4j and 4j+2, `hi` 4j+1 and 4j+3.
 uint scoreAt(uvec4 lo, uvec4 hi, int p) {
   uint v = (p & 1) == 0 ? lo[p >> 2] : hi[p >> 2];

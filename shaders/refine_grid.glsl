@@ -29,3 +29,24 @@ uint bandBit(UnitGrid g, int t, int band, int column) {
 }
 
 int bandOf(UnitGrid g, int row) { return (row + g.pad) / BAND; }
+
+// Runs of neighbouring units are scored together, up to MAX_SPAN units (refine_units.comp).
+// Each length has its own list in the runs buffer: a run of `span` units takes `span` of
+// the `capacity` unit slots, so that list needs at most capacity / span entries.
+const int MAX_SPAN = 4;  // match kMaxSpan in similarity_gpu.cpp
+uint runCapacity(uint capacity, int span) { return capacity / uint(span); }
+uint runRegion(uint capacity, int span) {
+  uint region = 0u;
+  for (int s = 1; s < span; ++s) region += runCapacity(capacity, s);
+  return region;
+}
+
+// The state buffer of a chunk's refinement (refine_args.comp writes the dispatch sizes).
+#define REFINE_STATE                                                                      \
+  uint unit_count;       /* this chunk's units (reset before each chunk) */               \
+  uint max_units;        /* most units of any chunk: more than the capacity: run again */ \
+  uint next_candidate;   /* first candidate of the next chunk */                          \
+  uint first_candidate;  /* first candidate of this chunk */                              \
+  uvec4 candidate_groups;          /* byte 16 */                                          \
+  uvec4 run_groups[MAX_SPAN];      /* byte 32: per run length */                          \
+  uint run_count[MAX_SPAN];        /* byte 32 + 16 MAX_SPAN */

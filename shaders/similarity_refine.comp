@@ -1,17 +1,22 @@
 #version 450
 // Stage 2, finer level: the scores of each unit (see refine_grid.glsl) of this chunk, BAND
-// rows of 16 positions packed as scoreSixteen leaves them.
+// rows of 16 positions packed as packed_scores.glsl reads them. An invocation scores a run of
+// SPAN neighbouring units (refine_units.comp): per row and feature SPAN + 1 texels.
 #include "similarity_common.glsl"
 #include "refine_grid.glsl"
+layout(constant_id = 0) const int SPAN = 1;
 layout(local_size_x = 64) in;
-layout(std430, binding = 3) readonly buffer Units { uint units[]; };
-layout(std430, binding = 4) readonly buffer State { uint unit_count; };
+layout(std430, binding = 3) readonly buffer Runs { uvec2 runs[]; };
+layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Scores { uvec4 scores[]; };
 layout(push_constant) uniform Push { int stride; uint capacity; UnitGrid grid; } pc;
 void main() {
   uint u = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
-  if (u >= min(unit_count, pc.capacity)) return;
-  int bit = int(units[u]);
+  if (u >= min(run_count[SPAN - 1], runCapacity(pc.capacity, SPAN))) return;
+  uvec2 run = runs[runRegion(pc.capacity, SPAN) + u];
+  uint slot = run.y;
+  if (slot + uint(SPAN) > pc.capacity) return;
+  int bit = int(run.x);
   int per_band = pc.grid.words_per_band * 32;
   int t = bit / (pc.grid.bands * per_band);
   int rest = bit - t * pc.grid.bands * per_band;
@@ -19,21 +24,33 @@ void main() {
   int column = (rest % per_band) * 16 - pc.grid.pad;
   int h = t * HEADER_INTS;
   int f = headers[h], end = f + headers[h + 1];
-  uint base = uint(row * pc.stride + column), stride = uint(pc.stride);
-  uvec4 lo[BAND], hi[BAND];
-  for (int r = 0; r < BAND; ++r) lo[r] = hi[r] = uvec4(0u);
+  uint base = uint(row * pc.stride + column);
+  int row_texels = pc.stride / 16;
+  uvec4 lo[BAND * SPAN], hi[BAND * SPAN];
+  for (int i = 0; i < BAND * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
   while (f < end) {
     int chunk_end = min(f + 63, end);
-    uvec4 acc[BAND];
-    for (int r = 0; r < BAND; ++r) acc[r] = uvec4(0u);
+    uvec4 acc[BAND * SPAN];
+    for (int i = 0; i < BAND * SPAN; ++i) acc[i] = uvec4(0u);
     for (; f < chunk_end; ++f) {
       uint off = uint(texelFetch(feature_offsets, f).x) + base;
-      for (int r = 0; r < BAND; ++r) acc[r] += sixteenBytes(off + uint(r) * stride);
+      // The stride is a multiple of 16, so every row has the same alignment.
+      uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
+      int first = int(off >> 4);
+      for (int r = 0; r < BAND; ++r) {
+        uvec4 x = texelFetch(memory, first + r * row_texels);
+        for (int k = 0; k < SPAN; ++k) {
+          uvec4 y = texelFetch(memory, first + r * row_texels + k + 1);
+          acc[r * SPAN + k] += alignBytes(x, y, q, s);
+          x = y;
+        }
+      }
     }
-    for (int r = 0; r < BAND; ++r) widen(acc[r], lo[r], hi[r]);
+    for (int i = 0; i < BAND * SPAN; ++i) widen(acc[i], lo[i], hi[i]);
   }
-  for (int r = 0; r < BAND; ++r) {
-    scores[(u * uint(BAND) + uint(r)) * 2u] = lo[r];
-    scores[(u * uint(BAND) + uint(r)) * 2u + 1u] = hi[r];
-  }
+  for (int k = 0; k < SPAN; ++k)
+    for (int r = 0; r < BAND; ++r) {
+      scores[((slot + uint(k)) * uint(BAND) + uint(r)) * 2u] = lo[r * SPAN + k];
+      scores[((slot + uint(k)) * uint(BAND) + uint(r)) * 2u + 1u] = hi[r * SPAN + k];
+    }
 }

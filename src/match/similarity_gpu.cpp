@@ -18,9 +18,22 @@ constexpr int kCoarseSpan = 3;  // blocks of 16 positions per coarse invocation:
 constexpr uint32_t kCoarseGroup = 16;
 constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
 constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
-// State buffer (refine_args.comp): unit count, most units of a chunk, next and this chunk's
-// first candidate, then the indirect dispatch sizes over the chunk's candidates and units.
-constexpr std::size_t kStateBytes = 48, kCandidateArgs = 16, kUnitArgs = 32;
+// Longest run of neighbouring units one refinement invocation scores: MAX_SPAN in
+// shaders/refine_grid.glsl. Runs of each length are listed apart and scored by a kernel
+// specialized for that length.
+constexpr uint32_t kMaxSpan = 4;
+// State buffer (REFINE_STATE in refine_grid.glsl): unit count, most units of a chunk, next
+// and this chunk's first candidate, the indirect dispatch sizes over the chunk's candidates
+// and over its runs of each length, then the run counts.
+constexpr std::size_t kCandidateArgs = 16, kRunArgs = 32, kRunCounts = kRunArgs + 16 * kMaxSpan,
+                      kStateBytes = kRunCounts + 4 * kMaxSpan;
+// Run list entries (runs of `span` units take `span` unit slots each): runRegion in
+// refine_grid.glsl.
+std::size_t runListEntries(uint32_t unit_capacity) {
+  std::size_t entries = 0;
+  for (uint32_t span = 1; span <= kMaxSpan; ++span) entries += unit_capacity / span;
+  return entries;
+}
 
 struct UnitGrid {
   int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0;
@@ -57,13 +70,19 @@ struct Similarity::Kernels {
         mark(c, ShaderId::refine_mark, 3, sizeof(ChunkPush)),
         units(c, ShaderId::refine_units, 4, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
-        refine(c, ShaderId::similarity_refine, 6, sizeof(RefinePush), {}, kMemoryAndOffsets),
+
         select(c, ShaderId::refine_select, 6, sizeof(ChunkPush), {},
-               {{0, vk::Format::eR32Uint}, {1, vk::Format::eR32Uint}, {2, vk::Format::eR32G32B32A32Uint}}) {}
+               {{0, vk::Format::eR32Uint}, {1, vk::Format::eR32Uint}, {2, vk::Format::eR32G32B32A32Uint}}) {
+    for (uint32_t span = 1; span <= kMaxSpan; ++span)
+      refine.push_back(std::make_unique<Kernel>(c, ShaderId::similarity_refine, 6, sizeof(RefinePush),
+                                                std::vector<uint32_t>{span}, kMemoryAndOffsets));
+  }
   // Linear memory and feature offsets are read as texel buffers (similarity_common.glsl).
   static inline const std::vector<TexelBinding> kMemoryAndOffsets{{0, vk::Format::eR32G32B32A32Uint},
                                                                   {2, vk::Format::eR32Sint}};
-  Kernel coarse, mark, units, args, refine, select;
+  Kernel coarse, mark, units, args;
+  std::vector<std::unique_ptr<Kernel>> refine;  // per run length (specialization constant SPAN)
+  Kernel select;
 };
 
 Similarity::Similarity(const GpuContext& ctx) : ctx_(ctx), kernels_(std::make_unique<Kernels>(ctx)) {}
@@ -159,7 +178,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     grid = unitGrid(cl, layouts_[0]);
     marks_.reserve(ctx_, mark_words_ * 4);
     bases_.reserve(ctx_, mark_words_ * 4);
-    units_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * 4);
+    runs_.reserve(ctx_, runListEntries(unit_capacity_) * 8);
     scores_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * kUnitScoreBytes);
   }
   const auto& fl = layouts_[0];
@@ -177,14 +196,16 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);
     batch.fill(marks_, 0u, words * 4);
     batch.dispatchIndirect(kernels_->mark, {candidates_, state_, marks_}, chunk_push, state_, kCandidateArgs);
-    batch.fill(state_, 0u, 4);  // this chunk's unit count
+    batch.fill(state_, 0u, 4);                          // this chunk's unit count
+    batch.fill(state_, 0u, 4 * kMaxSpan, kRunCounts);  // and run counts
     const auto g = groups2DFor(words, kGroup);
-    batch.dispatch(kernels_->units, {marks_, bases_, units_, state_},
+    batch.dispatch(kernels_->units, {marks_, bases_, runs_, state_},
                    UnitsPush{static_cast<uint32_t>(words), unit_capacity_}, g.x, g.y);
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{1, unit_capacity_, capacity_}, 1);
-    batch.dispatchIndirect(kernels_->refine,
-                           {features.memory(0), chunk.headers[0], chunk.offsets[0], units_, state_, scores_},
-                           RefinePush{fl.stride, unit_capacity_, grid}, state_, kUnitArgs);
+    for (uint32_t span = 1; span <= kMaxSpan; ++span)
+      batch.dispatchIndirect(*kernels_->refine[span - 1],
+                             {features.memory(0), chunk.headers[0], chunk.offsets[0], runs_, state_, scores_},
+                             RefinePush{fl.stride, unit_capacity_, grid}, state_, kRunArgs + 16 * (span - 1));
     batch.dispatchIndirect(kernels_->select, {marks_, bases_, scores_, candidates_, state_, results_}, chunk_push,
                            state_, kCandidateArgs);
   }

@@ -2,8 +2,8 @@
 // Stage 2 on the GPU: template headers and feature offsets on the device, coarse scoring of
 // every template, indirect refinement of the candidates, all recorded into the frame's batch.
 // Refinement scores each unit (one template, 4 finer-level rows, one 16-cell block) that
-// some candidate's window covers once (shaders/refine_grid.glsl), then picks each
-// candidate's best position from the units.
+// some candidate's window covers once (shaders/refine_grid.glsl), runs of neighbouring
+// units together, then picks each candidate's best position from the units.
 #include <memory>
 #include <vector>
 
@@ -57,7 +57,7 @@ class Similarity {
   uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk
   std::size_t mark_words_ = 0;         // mark words of the largest chunk
   Buffer candidates_, results_;
-  Buffer marks_, bases_, units_, scores_, state_;
+  Buffer marks_, bases_, runs_, scores_, state_;
 };
 
 }  // namespace vkpose::gpu
