@@ -27,6 +27,12 @@ void widen(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
 
 #include "packed_scores.glsl"
 
+// Highest of the 16 scores in `lo` and `hi`.
+uint maxOfSixteen(uvec4 lo, uvec4 hi) {
+  uvec4 m = max(max(lo & 0xFFFFu, lo >> 16u), max(hi & 0xFFFFu, hi >> 16u));
+  return max(max(m.x, m.y), max(m.z, m.w));
+}
+
 // Template header: first feature, feature count, first cell column, first cell row, raw
 // threshold, then the coarse level's columns and rows of positions (match::coarseRange),
 // unused.
