@@ -1,15 +1,19 @@
 // Refinement works on units: one template's responses at BAND consecutive finer-level rows
-// (padded rows BAND k .. BAND k + BAND - 1) and one 16-cell block of those rows (cells
-// -pad + 16 b .. -pad + 16 b + 15). Candidates of a template near each other have heavily
-// overlapping 16 x 16 windows; each unit they cover is scored once, and each feature's
-// offset is read once for the BAND rows. A chunk's units are bits of a mark array: per
-// template, per band, `words_per_band` words of one bit per block.
+// (padded rows BAND k .. BAND k + BAND - 1) and one block of 16 cells of those rows.
+// Candidates of a template near each other have heavily overlapping 16 x 16 windows; each
+// unit they cover is scored once, and each feature's offset is read once for the BAND rows.
+// The windows mark the padded columns they cover, per template and band (refine_mark.comp);
+// refine_units.comp then lays that band's blocks from its first marked column on (padded
+// columns shift + 16 k .. shift + 16 k + 15), so that a lone window is one block, not the
+// two that blocks fixed at multiples of 16 would cut it into. A chunk's units are bits of
+// a block mark array: per template, per band, `words_per_band` words of one bit per block.
 const int BAND = 4;  // match kUnitBand in similarity_gpu.cpp
 struct UnitGrid {
   int T_coarse, T_fine;
   int pad;             // finer layout's padding cells
   int bands;           // bands of the finer layout's padded rows
-  int words_per_band;  // mark words per band
+  int words_per_band;  // block mark words per band
+  int column_words;    // column mark words per band
 };
 
 int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
@@ -22,11 +26,8 @@ ivec2 windowStart(UnitGrid g, int r, int c) {
                floorDiv(2 * (c * g.T_coarse + offset) + 1, g.T_fine)) - 8;
 }
 
-// Bit of the unit of band `band` holding finer-level column `column` of the chunk's
-// template t.
-uint bandBit(UnitGrid g, int t, int band, int column) {
-  return uint((t * g.bands + band) * g.words_per_band * 32 + ((column + g.pad) >> 4));
-}
+// Bit of block k of band `band` of the chunk's template t.
+uint blockBit(UnitGrid g, int t, int band, int k) { return uint((t * g.bands + band) * g.words_per_band * 32 + k); }
 
 int bandOf(UnitGrid g, int row) { return (row + g.pad) / BAND; }
 

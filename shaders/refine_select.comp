@@ -5,40 +5,34 @@
 #include "packed_scores.glsl"
 #include "refine_grid.glsl"
 layout(local_size_x = 64) in;
-layout(binding = 0) uniform utextureBuffer marks;   // r32ui
+layout(binding = 0) uniform utextureBuffer blocks;  // r32ui
 layout(binding = 1) uniform utextureBuffer bases;   // r32ui
 layout(binding = 2) uniform utextureBuffer scores;  // rgba32ui, two texels per unit row
 layout(std430, binding = 3) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(std430, binding = 4) readonly buffer State { uint unit_count; uint max_units; uint next_candidate; uint first_candidate; };
 layout(std430, binding = 5) writeonly buffer Results { uvec2 results[]; };
+layout(binding = 6) uniform utextureBuffer shifts;  // r32ui, per template band
 layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;
 
 uint unitIndex(uint bit) {
   int word = int(bit >> 5);
-  uint below = texelFetch(marks, word).x & ((1u << (bit & 31u)) - 1u);
+  uint below = texelFetch(blocks, word).x & ((1u << (bit & 31u)) - 1u);
   return texelFetch(bases, word).x + uint(bitCount(below));
-}
-
-// Lane masks of the packed scores (lo, hi as packed_scores.glsl reads them) of the block
-// positions p with first <= p < end.
-void blockMasks(int first, int end, out uvec4 lo_mask, out uvec4 hi_mask) {
-  for (int c = 0; c < 4; ++c) {
-    int p = 4 * c;
-    lo_mask[c] = (p >= first && p < end ? 0xFFFFu : 0u) | (p + 2 >= first && p + 2 < end ? 0xFFFF0000u : 0u);
-    hi_mask[c] = (p + 1 >= first && p + 1 < end ? 0xFFFFu : 0u) | (p + 3 >= first && p + 3 < end ? 0xFFFF0000u : 0u);
-  }
 }
 
 // Per lane, the larger of the two packed 16-bit scores.
 uvec4 halvesMax(uvec4 x) { return max(x & 0xFFFFu, x >> 16u); }
 
-// The packed scores of window row `row`: block 0 holds window columns from o on, block 1
-// the rest.
-void windowRow(ivec2 start, int t, int o, int row, out uvec4 lo0, out uvec4 hi0, out uvec4 lo1, out uvec4 hi1) {
+// The packed scores of window row `row`: the window's columns are positions o .. o + 15 of
+// two consecutive blocks (one if o == 0) of the row's band, whose blocks start at its shift.
+void windowRow(ivec2 start, int t, int row, out int o, out uvec4 lo0, out uvec4 hi0, out uvec4 lo1, out uvec4 hi1) {
   int band = bandOf(pc.grid, start.x + row);
   int in_band = start.x + row + pc.grid.pad - band * BAND;
-  int u0 = int(unitIndex(bandBit(pc.grid, t, band, start.y))) * BAND + in_band;
-  int u1 = o == 0 ? u0 : int(unitIndex(bandBit(pc.grid, t, band, start.y + 15))) * BAND + in_band;
+  int column = start.y + pc.grid.pad - int(texelFetch(shifts, t * pc.grid.bands + band).x);
+  int k = column >> 4;
+  o = column & 15;
+  int u0 = int(unitIndex(blockBit(pc.grid, t, band, k))) * BAND + in_band;
+  int u1 = o == 0 ? u0 : int(unitIndex(blockBit(pc.grid, t, band, k + 1))) * BAND + in_band;
   lo0 = texelFetch(scores, 2 * u0);
   hi0 = texelFetch(scores, 2 * u0 + 1);
   lo1 = texelFetch(scores, 2 * u1);
@@ -51,27 +45,34 @@ void main() {
   uvec4 item = items[cand];
   int t = int(item.x) - pc.template_base;
   ivec2 start = windowStart(pc.grid, int(item.y), int(item.z));
-  // The window's columns are positions o .. o + 15 of two consecutive blocks (one if o == 0).
-  int o = (start.y + pc.grid.pad) & 15;
-  uvec4 lo_mask0, hi_mask0, lo_mask1, hi_mask1;
-  blockMasks(o, 16, lo_mask0, hi_mask0);
-  blockMasks(0, o, lo_mask1, hi_mask1);
-  // Each row's best in the window from masked packed maxima; then the first row holding
-  // the overall best, and in it the first column: 16 comparisons per row instead of 32
-  // position by position.
+  // Each row's best in the window from masked packed maxima (lo holds positions 4c and
+  // 4c + 2, hi 4c + 1 and 4c + 3); then the first row holding the overall best, and in it
+  // the first column: 16 comparisons per row instead of 32 position by position.
+  const uvec4 even = uvec4(0u, 4u, 8u, 12u);
   uint best = 0u;
   int best_row = 0;
   for (int row = 0; row < 16; ++row) {
+    int o;
     uvec4 lo0, hi0, lo1, hi1;
-    windowRow(start, t, o, row, lo0, hi0, lo1, hi1);
-    uvec4 m = max(max(halvesMax(lo0 & lo_mask0), halvesMax(hi0 & hi_mask0)),
-                  max(halvesMax(lo1 & lo_mask1), halvesMax(hi1 & hi_mask1)));
+    windowRow(start, t, row, o, lo0, hi0, lo1, hi1);
+    uvec4 first = uvec4(uint(o));
+    // Block 0 from position o on, block 1 before it.
+    uvec4 m0 = max(halvesMax(lo0 & (uvec4(greaterThanEqual(even, first)) * 0xFFFFu |
+                                     uvec4(greaterThanEqual(even + 2u, first)) * 0xFFFF0000u)),
+                   halvesMax(hi0 & (uvec4(greaterThanEqual(even + 1u, first)) * 0xFFFFu |
+                                    uvec4(greaterThanEqual(even + 3u, first)) * 0xFFFF0000u)));
+    uvec4 m1 = max(halvesMax(lo1 & (uvec4(lessThan(even, first)) * 0xFFFFu |
+                                     uvec4(lessThan(even + 2u, first)) * 0xFFFF0000u)),
+                   halvesMax(hi1 & (uvec4(lessThan(even + 1u, first)) * 0xFFFFu |
+                                    uvec4(lessThan(even + 3u, first)) * 0xFFFF0000u)));
+    uvec4 m = max(m0, m1);
     uint row_best = max(max(m.x, m.y), max(m.z, m.w));
     best_row = row_best > best ? row : best_row;
     best = max(best, row_best);
   }
+  int o;
   uvec4 lo0, hi0, lo1, hi1;
-  windowRow(start, t, o, best_row, lo0, hi0, lo1, hi1);
+  windowRow(start, t, best_row, o, lo0, hi0, lo1, hi1);
   int best_column = 0;
   for (int j = 31; j >= 0; --j) {
     uint s = j < 16 ? scoreAt(lo0, hi0, j) : scoreAt(lo1, hi1, j - 16);

@@ -6,22 +6,19 @@
 #include "refine_grid.glsl"
 layout(constant_id = 0) const int SPAN = 1;
 layout(local_size_x = 64) in;
-layout(std430, binding = 3) readonly buffer Runs { uvec2 runs[]; };
+layout(std430, binding = 3) readonly buffer Runs { uvec4 runs[]; };  // template band, padded column, slot
 layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Scores { uvec4 scores[]; };
 layout(push_constant) uniform Push { int stride; uint capacity; UnitGrid grid; } pc;
 void main() {
   uint u = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
   if (u >= min(run_count[SPAN - 1], runCapacity(pc.capacity, SPAN))) return;
-  uvec2 run = runs[runRegion(pc.capacity, SPAN) + u];
-  uint slot = run.y;
+  uvec4 run = runs[runRegion(pc.capacity, SPAN) + u];
+  uint slot = run.z;
   if (slot + uint(SPAN) > pc.capacity) return;
-  int bit = int(run.x);
-  int per_band = pc.grid.words_per_band * 32;
-  int t = bit / (pc.grid.bands * per_band);
-  int rest = bit - t * pc.grid.bands * per_band;
-  int row = (rest / per_band) * BAND - pc.grid.pad;
-  int column = (rest % per_band) * 16 - pc.grid.pad;
+  int t = int(run.x) / pc.grid.bands;
+  int row = (int(run.x) - t * pc.grid.bands) * BAND - pc.grid.pad;
+  int column = int(run.y) - pc.grid.pad;
   int h = t * HEADER_INTS;
   int f = headers[h], end = f + headers[h + 1];
   uint base = uint(row * pc.stride + column);

@@ -12,9 +12,11 @@ namespace vkpose::gpu {
 
 namespace {
 constexpr uint32_t kGroup = 64;
-// Zeros after the last plane: the coarse similarity pass fetches whole texels up to 64 bytes
-// past a row's last scanned position, which the bottom margin covers except at the very end.
-constexpr std::size_t kMemoryTailBytes = 64;
+// Zeros after the last plane, which the similarity kernels may read past (their values
+// never reach a score): the coarse pass fetches whole texels up to 64 bytes past a row's last
+// position, and refinement units cover 4 rows from a multiple of 4 (up to 3 rows past the
+// plane) in blocks that may end up to 31 bytes past a row.
+std::size_t memoryTailBytes(const LinearMemoryLayout& layout) { return 4 * static_cast<std::size_t>(layout.stride) + 64; }
 struct SizePush {
   int32_t width, height;
 };
@@ -115,9 +117,9 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     const LinearMemoryLayout& layout = layouts[l];
     const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
                       L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
-                      L.memory.size() == layout.total_bytes() + kMemoryTailBytes;
+                      L.memory.size() == layout.total_bytes() + memoryTailBytes(layout);
     if (!same) {
-      L.memory = Buffer(ctx_, layout.total_bytes() + kMemoryTailBytes);
+      L.memory = Buffer(ctx_, layout.total_bytes() + memoryTailBytes(layout));
       batch.fill(L.memory, 0u);
       L.layout = layout;
     }

@@ -36,14 +36,15 @@ std::size_t runListEntries(uint32_t unit_capacity) {
 }
 
 struct UnitGrid {
-  int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0;
+  int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0, column_words = 0;
 };
 struct CoarsePush {
   int32_t template_base, stride;
   uint32_t capacity;
 };
 struct UnitsPush {
-  uint32_t words, capacity;
+  uint32_t bands, capacity;  // template bands of the chunk, unit slots
+  UnitGrid grid;
 };
 struct ArgsPush {
   uint32_t stage, unit_capacity, candidate_capacity;
@@ -58,9 +59,11 @@ struct ChunkPush {  // refine_mark, refine_select
   UnitGrid grid;
 };
 
+// Blocks of a band (refine_grid.glsl): from the band's first marked column on, at most
+// stride / 16 of them, as the stride is a multiple of 16.
 UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fine) {
   return {coarse.T, fine.T, fine.pad, (fine.rows + kUnitBand - 1) / kUnitBand,
-          (fine.stride / match::kRefineWindow + 31) / 32};
+          (fine.stride / match::kRefineWindow + 31) / 32, (fine.stride + 31) / 32};
 }
 }  // namespace
 
@@ -68,11 +71,14 @@ struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
       : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush), {}, kMemoryAndOffsets),
         mark(c, ShaderId::refine_mark, 3, sizeof(ChunkPush)),
-        units(c, ShaderId::refine_units, 4, sizeof(UnitsPush)),
+        units(c, ShaderId::refine_units, 6, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
 
-        select(c, ShaderId::refine_select, 6, sizeof(ChunkPush), {},
-               {{0, vk::Format::eR32Uint}, {1, vk::Format::eR32Uint}, {2, vk::Format::eR32G32B32A32Uint}}) {
+        select(c, ShaderId::refine_select, 7, sizeof(ChunkPush), {},
+               {{0, vk::Format::eR32Uint},
+                {1, vk::Format::eR32Uint},
+                {2, vk::Format::eR32G32B32A32Uint},
+                {6, vk::Format::eR32Uint}}) {
     for (uint32_t span = 1; span <= kMaxSpan; ++span)
       refine.push_back(std::make_unique<Kernel>(c, ShaderId::similarity_refine, 6, sizeof(RefinePush),
                                                 std::vector<uint32_t>{span}, kMemoryAndOffsets));
@@ -158,7 +164,9 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   }
   if (levels > 1) {
     const UnitGrid grid = unitGrid(layouts[levels - 1], layouts[0]);
-    mark_words_ = largest * static_cast<std::size_t>(grid.bands) * static_cast<std::size_t>(grid.words_per_band);
+    template_bands_ = largest * static_cast<std::size_t>(grid.bands);
+    block_words_ = template_bands_ * static_cast<std::size_t>(grid.words_per_band);
+    column_words_ = template_bands_ * static_cast<std::size_t>(grid.column_words);
     max_unit_capacity_ = static_cast<uint32_t>(largest * units_per_template);
     unit_capacity_ = std::min(unit_capacity_, max_unit_capacity_);
   }
@@ -176,16 +184,17 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
   UnitGrid grid;
   if (refine) {
     grid = unitGrid(cl, layouts_[0]);
-    marks_.reserve(ctx_, mark_words_ * 4);
-    bases_.reserve(ctx_, mark_words_ * 4);
-    runs_.reserve(ctx_, runListEntries(unit_capacity_) * 8);
+    columns_.reserve(ctx_, column_words_ * 4);
+    blocks_.reserve(ctx_, block_words_ * 4);
+    bases_.reserve(ctx_, block_words_ * 4);
+    shifts_.reserve(ctx_, template_bands_ * 4);
+    runs_.reserve(ctx_, runListEntries(unit_capacity_) * 16);
     scores_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * kUnitScoreBytes);
   }
   const auto& fl = layouts_[0];
   for (std::size_t c = begin; c < std::min(end, chunks_.size()); ++c) {
     const Chunk& chunk = chunks_[c];
-    const std::size_t words = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands) *
-                              static_cast<std::size_t>(grid.words_per_band);
+    const std::size_t bands = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands);
     const CoarsePush push{chunk.first_template, cl.stride, capacity_};
     if (chunk.coarse_invocations > 0)
       batch.dispatch(kernels_->coarse,
@@ -194,20 +203,20 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);
-    batch.fill(marks_, 0u, words * 4);
-    batch.dispatchIndirect(kernels_->mark, {candidates_, state_, marks_}, chunk_push, state_, kCandidateArgs);
+    batch.fill(columns_, 0u, bands * static_cast<std::size_t>(grid.column_words) * 4);
+    batch.dispatchIndirect(kernels_->mark, {candidates_, state_, columns_}, chunk_push, state_, kCandidateArgs);
     batch.fill(state_, 0u, 4);                          // this chunk's unit count
     batch.fill(state_, 0u, 4 * kMaxSpan, kRunCounts);  // and run counts
-    const auto g = groups2DFor(words, kGroup);
-    batch.dispatch(kernels_->units, {marks_, bases_, runs_, state_},
-                   UnitsPush{static_cast<uint32_t>(words), unit_capacity_}, g.x, g.y);
+    const auto g = groups2DFor(bands, kGroup);
+    batch.dispatch(kernels_->units, {columns_, blocks_, bases_, shifts_, runs_, state_},
+                   UnitsPush{static_cast<uint32_t>(bands), unit_capacity_, grid}, g.x, g.y);
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{1, unit_capacity_, capacity_}, 1);
     for (uint32_t span = 1; span <= kMaxSpan; ++span)
       batch.dispatchIndirect(*kernels_->refine[span - 1],
                              {features.memory(0), chunk.headers[0], chunk.offsets[0], runs_, state_, scores_},
                              RefinePush{fl.stride, unit_capacity_, grid}, state_, kRunArgs + 16 * (span - 1));
-    batch.dispatchIndirect(kernels_->select, {marks_, bases_, scores_, candidates_, state_, results_}, chunk_push,
-                           state_, kCandidateArgs);
+    batch.dispatchIndirect(kernels_->select, {blocks_, bases_, scores_, candidates_, state_, results_, shifts_},
+                           chunk_push, state_, kCandidateArgs);
   }
 }
 

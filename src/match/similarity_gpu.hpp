@@ -55,9 +55,11 @@ class Similarity {
   bool full_ = false;                  // the last pass overflowed max_capacity_
   uint32_t unit_capacity_ = 1u << 16;  // unit slots of one chunk
   uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk
-  std::size_t mark_words_ = 0;         // mark words of the largest chunk
+  std::size_t template_bands_ = 0;     // template bands of the largest chunk
+  std::size_t block_words_ = 0;        // and its block mark words
+  std::size_t column_words_ = 0;       // and its column mark words
   Buffer candidates_, results_;
-  Buffer marks_, bases_, runs_, scores_, state_;
+  Buffer columns_, blocks_, bases_, shifts_, runs_, scores_, state_;
 };
 
 }  // namespace vkpose::gpu
