@@ -14,6 +14,7 @@ layout(push_constant) uniform Push {
 } pc;
 const int ROWS = 2;  // match kCoarseRows in similarity_gpu.cpp
 const int SPAN = 3;  // match kCoarseSpan in similarity_gpu.cpp
+const uint LAST_OF_GROUP = 1u << 30;  // match kLastOfGroup in similarity_gpu.cpp
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
   int t = int(gl_WorkGroupID.y);
@@ -31,25 +32,26 @@ void main() {
   int row_texels = pc.stride / 16;
   uvec4 lo[ROWS * SPAN], hi[ROWS * SPAN];
   for (int i = 0; i < ROWS * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
+  // The features come in groups of one read alignment (at most 63, the last one flagged;
+  // setTemplates): a group's raw texels add up, byte sums that never carry, so they are
+  // aligned once per group instead of once per feature.
   while (f < end) {
-    int chunk_end = min(f + 63, end);
-    uvec4 acc[ROWS * SPAN];
-    for (int i = 0; i < ROWS * SPAN; ++i) acc[i] = uvec4(0u);
-    for (; f < chunk_end; ++f) {
-      uint off = uint(texelFetch(feature_offsets, f).x) + base;
+    uvec4 raw[ROWS * (SPAN + 1)];
+    for (int i = 0; i < ROWS * (SPAN + 1); ++i) raw[i] = uvec4(0u);
+    uint off, word;
+    do {
+      word = uint(texelFetch(feature_offsets, f).x);
+      off = (word & ~LAST_OF_GROUP) + base;
       // The stride is a multiple of 16, so every row has the same alignment.
-      uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
       int first = int(off >> 4);
-      for (int r = 0; r < ROWS; ++r) {
-        uvec4 x = texelFetch(memory, first + r * row_texels);
-        for (int k = 0; k < SPAN; ++k) {
-          uvec4 y = texelFetch(memory, first + r * row_texels + k + 1);
-          acc[r * SPAN + k] += alignBytes(x, y, q, s);
-          x = y;
-        }
-      }
-    }
-    for (int i = 0; i < ROWS * SPAN; ++i) widen(acc[i], lo[i], hi[i]);
+      for (int r = 0; r < ROWS; ++r)
+        for (int k = 0; k <= SPAN; ++k) raw[r * (SPAN + 1) + k] += texelFetch(memory, first + r * row_texels + k);
+      ++f;
+    } while ((word & LAST_OF_GROUP) == 0u);
+    uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
+    for (int r = 0; r < ROWS; ++r)
+      for (int k = 0; k < SPAN; ++k)
+        widen(alignBytes(raw[r * (SPAN + 1) + k], raw[r * (SPAN + 1) + k + 1], q, s), lo[r * SPAN + k], hi[r * SPAN + k]);
   }
   uint threshold = uint(headers[h + 4]);
   // Few positions pass. llvmpipe runs both sides of every `if` under a lane mask, so the
