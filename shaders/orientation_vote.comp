@@ -11,15 +11,19 @@ void main() {
   int i = LINEAR_INVOCATION;
   if (i >= pc.width * pc.height) return;
   int y = i / pc.width, x = i - y * pc.width;
-  uint label = 0u;
-  if (x > 0 && y > 0 && x < pc.width - 1 && y < pc.height - 1 && float(magnitude[i]) > pc.threshold_sq) {
-    int histogram[8] = int[](0, 0, 0, 0, 0, 0, 0, 0);
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) histogram[int(bins[i + dy * pc.width + dx])]++;
-    int best = 0;
-    for (int b = 1; b < 8; ++b)
-      if (histogram[b] > histogram[best]) best = b;
-    if (histogram[best] >= 5) label = 1u << best;
+  // The 3x3 histogram of bins as 4-bit counts in one word (at most 9 each): no per-lane
+  // array indexing, which is a loop over the lanes on llvmpipe.
+  bool inside = x > 0 && y > 0 && x < pc.width - 1 && y < pc.height - 1;
+  uint histogram = 0u;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      histogram += 1u << (4u * uint(bins[clamp(i + dy * pc.width + dx, 0, pc.width * pc.height - 1)]));
+  uint best = 0u, best_count = histogram & 15u;
+  for (uint b = 1u; b < 8u; ++b) {
+    uint count = (histogram >> (4u * b)) & 15u;
+    best = count > best_count ? b : best;
+    best_count = max(best_count, count);
   }
+  uint label = inside && float(magnitude[i]) > pc.threshold_sq && best_count >= 5u ? 1u << best : 0u;
   labels[i] = uint8_t(label);
 }
