@@ -131,7 +131,13 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
-      batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush, groups);
+      // One invocation per four padded cells of a pixel row and grid column
+      // (response_linearize.comp).
+      const int cells_x = (L.size.width + layout.T - 1) / layout.T;
+      const auto quads = static_cast<std::size_t>((layout.pad + cells_x + 3) / 4 - layout.pad / 4);
+      batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
+                           groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * quads,
+                                     kGroup));
     }
   }
 }
