@@ -2,7 +2,6 @@
 // border fixed). shaders/similarity_coarse.comp and similarity_refine.comp compute the same
 // candidates and refinements.
 #include <algorithm>
-#include <set>
 #include <tuple>
 
 #include "match/match_geometry.hpp"
@@ -25,7 +24,6 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
   const std::size_t coarse = fp.T.size() - 1;
   const int Tc = fp.T[coarse];
   std::vector<Match> out;
-  std::set<std::tuple<int, int, int>> seen;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const auto& cand = candidates[i];
     const auto& t = templates[static_cast<std::size_t>(cand.template_id)];
@@ -47,9 +45,16 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
       m.similarity = similarityPercent(ref.score, featureCount(t, 0));
       if (m.similarity < params.threshold) continue;
     }
-    if (seen.insert({m.template_id, m.x, m.y}).second) out.push_back(m);
+    out.push_back(m);
   }
+  // Candidates whose refinements land on the same position of a template give the same
+  // match; sorted, they are neighbours.
   sortMatches(out);
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const Match& a, const Match& b) {
+                          return a.template_id == b.template_id && a.x == b.x && a.y == b.y;
+                        }),
+            out.end());
   return out;
 }
 
