@@ -1,11 +1,13 @@
 #version 450
 // Marks the padded columns (refine_grid.glsl) that the refinement windows of this chunk's
-// candidates cover, per template and band of the window: 16 bits, one or two atomicOr.
+// candidates cover, per template and band of the window: 16 bits, one or two atomicOr,
+// and the band's bit in the occupancy mask that refine_units.comp reads first.
 #include "refine_grid.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(std430, binding = 1) readonly buffer State { uint unit_count; uint max_units; uint next_candidate; uint first_candidate; };
 layout(std430, binding = 2) buffer ColumnMarks { uint columns[]; };
+layout(std430, binding = 3) buffer Occupied { uint occupied[]; };  // a bit per template band
 layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;
 void main() {
   uint cand = first_candidate + gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
@@ -14,7 +16,9 @@ void main() {
   int t = int(item.x) - pc.template_base;
   ivec2 start = windowStart(pc.grid, int(item.y), int(item.z));
   for (int band = bandOf(pc.grid, start.x); band <= bandOf(pc.grid, start.x + 15); ++band) {
-    uint bit = uint((t * pc.grid.bands + band) * pc.grid.column_words * 32 + start.y + pc.grid.pad);
+    uint tb = uint(t * pc.grid.bands + band);
+    atomicOr(occupied[tb >> 5], 1u << (tb & 31u));
+    uint bit = tb * uint(pc.grid.column_words * 32) + uint(start.y + pc.grid.pad);
     uint s = bit & 31u;
     atomicOr(columns[bit >> 5], 0xFFFFu << s);
     if (s > 16u) atomicOr(columns[(bit >> 5) + 1u], 0xFFFFu >> (32u - s));

@@ -14,10 +14,13 @@ layout(std430, binding = 2) writeonly buffer Bases { uint bases[]; };
 layout(std430, binding = 3) writeonly buffer Shifts { uint shifts[]; };
 layout(std430, binding = 4) writeonly buffer Runs { uvec4 runs[]; };
 layout(std430, binding = 5) buffer State { REFINE_STATE };
+layout(std430, binding = 6) readonly buffer Occupied { uint occupied[]; };  // a bit per template band
 layout(push_constant) uniform Push { uint bands; uint capacity; UnitGrid grid; } pc;
 void main() {
   uint tb = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
   if (tb >= pc.bands) return;
+  // Most bands hold no window: one word tells, where the column words would take several.
+  if ((occupied[tb >> 5] & (1u << (tb & 31u))) == 0u) return;
   uint first_word = tb * uint(pc.grid.column_words);
   int first = -1;
   for (int w = pc.grid.column_words - 1; w >= 0; --w) {

@@ -89,8 +89,8 @@ UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fi
 struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
       : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush), {}, kMemoryAndOffsets),
-        mark(c, ShaderId::refine_mark, 3, sizeof(ChunkPush)),
-        units(c, ShaderId::refine_units, 6, sizeof(UnitsPush)),
+        mark(c, ShaderId::refine_mark, 4, sizeof(ChunkPush)),
+        units(c, ShaderId::refine_units, 7, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
 
         select(c, ShaderId::refine_select, 7, sizeof(ChunkPush), {},
@@ -209,6 +209,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     blocks_.reserve(ctx_, block_words_ * 4);
     bases_.reserve(ctx_, block_words_ * 4);
     shifts_.reserve(ctx_, template_bands_ * 4);
+    occupied_.reserve(ctx_, (template_bands_ + 31) / 32 * 4);
     runs_.reserve(ctx_, runListEntries(unit_capacity_) * 16);
     scores_.reserve(ctx_, static_cast<std::size_t>(unit_capacity_) * kUnitScoreBytes);
   }
@@ -225,11 +226,13 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     const ChunkPush chunk_push{chunk.first_template, grid};
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);
     batch.fill(columns_, 0u, bands * static_cast<std::size_t>(grid.column_words) * 4);
-    batch.dispatchIndirect(kernels_->mark, {candidates_, state_, columns_}, chunk_push, state_, kCandidateArgs);
+    batch.fill(occupied_, 0u, (bands + 31) / 32 * 4);
+    batch.dispatchIndirect(kernels_->mark, {candidates_, state_, columns_, occupied_}, chunk_push, state_,
+                           kCandidateArgs);
     batch.fill(state_, 0u, 4);                          // this chunk's unit count
     batch.fill(state_, 0u, 4 * kMaxSpan, kRunCounts);  // and run counts
     const auto g = groups2DFor(bands, kGroup);
-    batch.dispatch(kernels_->units, {columns_, blocks_, bases_, shifts_, runs_, state_},
+    batch.dispatch(kernels_->units, {columns_, blocks_, bases_, shifts_, runs_, state_, occupied_},
                    UnitsPush{static_cast<uint32_t>(bands), unit_capacity_, grid}, g.x, g.y);
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{1, unit_capacity_, capacity_}, 1);
     for (uint32_t span = 1; span <= kMaxSpan; ++span)

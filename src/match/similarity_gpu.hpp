@@ -59,7 +59,7 @@ class Similarity {
   std::size_t block_words_ = 0;        // and its block mark words
   std::size_t column_words_ = 0;       // and its column mark words
   Buffer candidates_, results_;
-  Buffer columns_, blocks_, bases_, shifts_, runs_, scores_, state_;
+  Buffer columns_, occupied_, blocks_, bases_, shifts_, runs_, scores_, state_;
 };
 
 }  // namespace vkpose::gpu
