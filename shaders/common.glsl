@@ -2,6 +2,13 @@
 // twins live in src/match/border.hpp and src/match/*_reference.cpp.
 #extension GL_EXT_shader_8bit_storage : require
 #extension GL_EXT_shader_16bit_storage : require
+#extension GL_EXT_control_flow_attributes : require
+
+// Sliding-window kernels take GROUP neighbouring outputs per invocation: neighbours share
+// most of their inputs, and on llvmpipe each byte or short load from a storage buffer is a
+// loop over the lanes. The loops over a group carry [[unroll]]: their small arrays must
+// be indexed by constants, an indexed local array being a loop over the lanes too.
+const int GROUP = 4;  // kPixelGroup in frame_features_gpu.cpp
 
 // BORDER_REPLICATE
 int clampIndex(int i, int n) { return clamp(i, 0, n - 1); }

@@ -1,5 +1,6 @@
 #version 450
-// Horizontal pass of the 7x7 binomial blur (8.8 fixed point, replicated border).
+// Horizontal pass of the 7x7 binomial blur (8.8 fixed point, replicated border), GROUP
+// neighbouring pixels of a row per invocation (common.glsl).
 #include "common.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Src { uint8_t src[]; };
@@ -8,11 +9,17 @@ layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
   int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
-  for (int ch = 0; ch < 3; ++ch) {
-    uint acc = 0u;
-    for (int t = 0; t < 7; ++t) acc += k[t] * uint(src[(y * pc.width + clampIndex(x + t - 3, pc.width)) * 3 + ch]);
-    dst[i * 3 + ch] = uint16_t(acc);
+  int per_row = (pc.width + GROUP - 1) / GROUP;
+  if (i >= per_row * pc.height) return;
+  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  [[unroll]] for (int ch = 0; ch < 3; ++ch) {
+    uint v[GROUP + 6];
+    [[unroll]] for (int t = 0; t < GROUP + 6; ++t)
+      v[t] = uint(src[(y * pc.width + clampIndex(x0 + t - 3, pc.width)) * 3 + ch]);
+    [[unroll]] for (int j = 0; j < GROUP; ++j) {
+      uint acc = 0u;
+      [[unroll]] for (int t = 0; t < 7; ++t) acc += k[t] * v[j + t];
+      if (x0 + j < pc.width) dst[(y * pc.width + x0 + j) * 3 + ch] = uint16_t(acc);
+    }
   }
 }

@@ -10,27 +10,38 @@ uint bitsToBytes(uint v) { return (v & 1u) | ((v & 2u) << 7u) | ((v & 4u) << 14u
 
 void main() {
   int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
+  int per_row = (pc.width + GROUP - 1) / GROUP;
+  if (i >= per_row * pc.height) return;
+  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
   // Labels take 9 values (0 and 1 << b): the median is the value where the running count
   // of a 9-bin histogram first exceeds 12. The histogram of bins 1..8 is a byte per label
-  // bit in two words (each count at most 25), so no per-lane array indexing (an indirect
-  // array access is a loop over the lanes on llvmpipe).
-  uint low = 0u, high = 0u;
-  for (int dy = -2; dy <= 2; ++dy)
-    for (int dx = -2; dx <= 2; ++dx) {
-      uint v = uint(src[clampIndex(y + dy, pc.height) * pc.width + clampIndex(x + dx, pc.width)]);
-      low += bitsToBytes(v & 15u);
-      high += bitsToBytes(v >> 4);
+  // bit in two words (each count at most 25), so no per-lane array indexing. GROUP
+  // neighbouring pixels of a row per invocation (common.glsl) share the 5 x (GROUP + 4)
+  // loads.
+  uint low[GROUP], high[GROUP];
+  [[unroll]] for (int j = 0; j < GROUP; ++j) low[j] = high[j] = 0u;
+  [[unroll]] for (int dy = -2; dy <= 2; ++dy) {
+    int row = clampIndex(y + dy, pc.height) * pc.width;
+    [[unroll]] for (int t = 0; t < GROUP + 4; ++t) {
+      uint v = uint(src[row + clampIndex(x0 + t - 2, pc.width)]);
+      uint l = bitsToBytes(v & 15u), h = bitsToBytes(v >> 4);
+      [[unroll]] for (int j = 0; j < GROUP; ++j)
+        if (t >= j && t <= j + 4) {
+          low[j] += l;
+          high[j] += h;
+        }
     }
-  uint counts = low + high;
-  int seen = 25 - int((counts & 0xFFu) + ((counts >> 8) & 0xFFu) + ((counts >> 16) & 0xFFu) + (counts >> 24));
-  uint median = 0u;
-  bool found = seen > 12;
-  for (int b = 0; b < 8; ++b) {
-    seen += int(((b < 4 ? low : high) >> (8u * uint(b & 3))) & 0xFFu);
-    median = !found && seen > 12 ? 1u << uint(b) : median;
-    found = found || seen > 12;
   }
-  dst[i] = uint8_t(median);
+  [[unroll]] for (int j = 0; j < GROUP; ++j) {
+    uint counts = low[j] + high[j];
+    int seen = 25 - int((counts & 0xFFu) + ((counts >> 8) & 0xFFu) + ((counts >> 16) & 0xFFu) + (counts >> 24));
+    uint median = 0u;
+    bool found = seen > 12;
+    [[unroll]] for (int b = 0; b < 8; ++b) {
+      seen += int(((b < 4 ? low[j] : high[j]) >> (8u * uint(b & 3))) & 0xFFu);
+      median = !found && seen > 12 ? 1u << uint(b) : median;
+      found = found || seen > 12;
+    }
+    if (x0 + j < pc.width) dst[y * pc.width + x0 + j] = uint8_t(median);
+  }
 }

@@ -12,6 +12,7 @@ namespace vkpose::gpu {
 
 namespace {
 constexpr uint32_t kGroup = 64;
+constexpr std::size_t kPixelGroup = 4;  // GROUP in shaders/common.glsl
 // Zeros after the last plane, which the similarity kernels may read past (their values
 // never reach a score): the coarse pass fetches whole texels up to 64 bytes past a row's last
 // position, and refinement units cover 4 rows from a multiple of 4 (up to 3 rows past the
@@ -69,6 +70,11 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     const std::size_t n = static_cast<std::size_t>(L.size.area());
     const SizePush sp{L.size.width, L.size.height};
     const uint32_t groups = groupsFor(n, kGroup);
+    // Sliding-window kernels take kPixelGroup neighbouring pixels of a row, or of a column,
+    // per invocation (GROUP in shaders/common.glsl).
+    const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
+    const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kGroup);
+    const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
 
     if (params_.use_colour) {
       L.bgr.reserve(ctx_, n * 3);
@@ -85,8 +91,9 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       L.raw_bins.reserve(ctx_, n);
       L.magnitude.reserve(ctx_, n * 4);
       L.labels[0].reserve(ctx_, n);
-      batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, groups);
-      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, groupsFor(n * 3, kGroup));
+      batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
+      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp,
+                           groupsFor(3 * w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup));
       batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, groups);
       struct {
         int32_t width, height;
@@ -104,7 +111,7 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
         const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
                                  params_.difference_threshold_mm};
         batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, groups);
-        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, groups);
+        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, row_groups);
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
@@ -128,8 +135,8 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
       const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
-      batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, groups);
-      batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, groups);
+      batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, row_groups);
+      batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, column_groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
       // One invocation per four padded cells of a pixel row and grid column
       // (response_linearize.comp).
