@@ -7,21 +7,40 @@ layout(std430, binding = 0) readonly buffer Src { uint8_t img[]; };
 layout(std430, binding = 1) writeonly buffer Bins { uint8_t bins[]; };
 layout(std430, binding = 2) writeonly buffer Mag { int magnitude[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
-int px(int y, int x, int ch) { return int(img[(y * pc.width + x) * 3 + ch]); }
 void main() {
   int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
-  int u = clampIndex(y - 1, pc.height), d = clampIndex(y + 1, pc.height);
-  int l = clampIndex(x - 1, pc.width), r = clampIndex(x + 1, pc.width);
-  int best_gx = 0, best_gy = 0, best_mag = -1;
-  for (int ch = 0; ch < 3; ++ch) {
-    int gx = (px(u, r, ch) + 2 * px(y, r, ch) + px(d, r, ch)) - (px(u, l, ch) + 2 * px(y, l, ch) + px(d, l, ch));
-    int gy = (px(d, l, ch) + 2 * px(d, x, ch) + px(d, r, ch)) - (px(u, l, ch) + 2 * px(u, x, ch) + px(u, r, ch));
-    int mag = gx * gx + gy * gy;
-    if (mag > best_mag) { best_mag = mag; best_gx = gx; best_gy = gy; }
+  int per_row = (pc.width + GROUP - 1) / GROUP;
+  if (i >= per_row * pc.height) return;
+  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  // GROUP neighbouring pixels of a row (common.glsl) share their 3 x (GROUP + 2) loads per
+  // channel.
+  int rows[3] = int[](clampIndex(y - 1, pc.height) * pc.width, y * pc.width, clampIndex(y + 1, pc.height) * pc.width);
+  int best_gx[GROUP], best_gy[GROUP], best_mag[GROUP];
+  [[unroll]] for (int j = 0; j < GROUP; ++j) {
+    best_gx[j] = best_gy[j] = 0;
+    best_mag[j] = -1;
   }
-  magnitude[i] = best_mag;
-  bool border = x == 0 || y == 0 || x == pc.width - 1 || y == pc.height - 1;
-  bins[i] = uint8_t(border ? 0 : gradientOrientationBin(best_gx, best_gy));
+  [[unroll]] for (int ch = 0; ch < 3; ++ch) {
+    int v[3][GROUP + 2];
+    [[unroll]] for (int r = 0; r < 3; ++r)
+      [[unroll]] for (int t = 0; t < GROUP + 2; ++t) v[r][t] = int(img[(rows[r] + clampIndex(x0 + t - 1, pc.width)) * 3 + ch]);
+    [[unroll]] for (int j = 0; j < GROUP; ++j) {
+      // Columns j (left), j + 1 (centre), j + 2 (right) of the loaded window.
+      int gx = (v[0][j + 2] + 2 * v[1][j + 2] + v[2][j + 2]) - (v[0][j] + 2 * v[1][j] + v[2][j]);
+      int gy = (v[2][j] + 2 * v[2][j + 1] + v[2][j + 2]) - (v[0][j] + 2 * v[0][j + 1] + v[0][j + 2]);
+      int mag = gx * gx + gy * gy;
+      bool better = mag > best_mag[j];
+      best_gx[j] = better ? gx : best_gx[j];
+      best_gy[j] = better ? gy : best_gy[j];
+      best_mag[j] = better ? mag : best_mag[j];
+    }
+  }
+  [[unroll]] for (int j = 0; j < GROUP; ++j) {
+    int x = x0 + j;
+    if (x < pc.width) {
+      magnitude[y * pc.width + x] = best_mag[j];
+      bool border = x == 0 || y == 0 || x == pc.width - 1 || y == pc.height - 1;
+      bins[y * pc.width + x] = uint8_t(border ? 0 : gradientOrientationBin(best_gx[j], best_gy[j]));
+    }
+  }
 }

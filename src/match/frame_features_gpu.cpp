@@ -94,12 +94,12 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
       batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp,
                            groupsFor(3 * w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup));
-      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, groups);
+      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, row_groups);
       struct {
         int32_t width, height;
         float threshold_sq;
       } vp{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
-      batch.dispatchLinear(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, groups);
+      batch.dispatchLinear(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, row_groups);
     }
     if (params_.use_depth) {
       L.labels[1].reserve(ctx_, n);
