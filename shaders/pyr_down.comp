@@ -8,18 +8,28 @@ layout(push_constant) uniform Push { int src_width; int src_height; int width; i
 const int k[5] = int[](1, 4, 6, 4, 1);
 void main() {
   int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
-  int cols[5];
-  for (int t = 0; t < 5; ++t) cols[t] = reflect101Index(2 * x + t - 2, pc.src_width);
-  for (int ch = 0; ch < 3; ++ch) {
-    int acc = 0;
-    for (int j = 0; j < 5; ++j) {
-      int row = reflect101Index(2 * y + j - 2, pc.src_height) * pc.src_width;
-      int racc = 0;
-      for (int t = 0; t < 5; ++t) racc += k[t] * int(src[(row + cols[t]) * 3 + ch]);
-      acc += k[j] * racc;
+  int per_row = (pc.width + GROUP - 1) / GROUP;
+  if (i >= per_row * pc.height) return;
+  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  // GROUP neighbouring output pixels of a row (common.glsl) share the 2 GROUP + 3 source
+  // columns of their windows.
+  int cols[2 * GROUP + 3];
+  [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) cols[t] = reflect101Index(2 * x0 + t - 2, pc.src_width);
+  int rows[5];
+  [[unroll]] for (int r = 0; r < 5; ++r) rows[r] = reflect101Index(2 * y + r - 2, pc.src_height) * pc.src_width;
+  [[unroll]] for (int ch = 0; ch < 3; ++ch) {
+    int acc[GROUP];
+    [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0;
+    [[unroll]] for (int r = 0; r < 5; ++r) {
+      int v[2 * GROUP + 3];
+      [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) v[t] = int(src[(rows[r] + cols[t]) * 3 + ch]);
+      [[unroll]] for (int j = 0; j < GROUP; ++j) {
+        int racc = 0;
+        [[unroll]] for (int t = 0; t < 5; ++t) racc += k[t] * v[2 * j + t];
+        acc[j] += k[r] * racc;
+      }
     }
-    dst[i * 3 + ch] = uint8_t((acc + 128) >> 8);
+    [[unroll]] for (int j = 0; j < GROUP; ++j)
+      if (x0 + j < pc.width) dst[(y * pc.width + x0 + j) * 3 + ch] = uint8_t((acc[j] + 128) >> 8);
   }
 }

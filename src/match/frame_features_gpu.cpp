@@ -84,7 +84,7 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
-        batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, groups);
+        batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, row_groups);
       }
       L.blur_rows.reserve(ctx_, n * 3 * 2);
       L.smoothed.reserve(ctx_, n * 3);
