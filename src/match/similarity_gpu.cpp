@@ -59,8 +59,6 @@ struct ChunkPush {  // refine_mark, refine_select
   UnitGrid grid;
 };
 
-// Blocks of a band (refine_grid.glsl): from the band's first marked column on, at most
-// stride / 16 of them, as the stride is a multiple of 16.
 // The coarse kernel adds the raw texels of features whose reads share an alignment and
 // aligns each group's sum once (similarity_coarse.comp): a template's coarse feature
 // offsets sorted by that alignment (a coarse invocation starts at column c_lo + 48 k, and
@@ -80,6 +78,8 @@ void groupByAlignment(std::vector<int32_t>::iterator begin, std::vector<int32_t>
   }
 }
 
+// Blocks of a band (refine_grid.glsl): from the band's first marked column on, at most
+// stride / 16 of them, as the stride is a multiple of 16.
 UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fine) {
   return {coarse.T, fine.T, fine.pad, (fine.rows + kUnitBand - 1) / kUnitBand,
           (fine.stride / match::kRefineWindow + 31) / 32, (fine.stride + 31) / 32};
@@ -92,7 +92,6 @@ struct Similarity::Kernels {
         mark(c, ShaderId::refine_mark, 4, sizeof(ChunkPush)),
         units(c, ShaderId::refine_units, 7, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
-
         select(c, ShaderId::refine_select, 7, sizeof(ChunkPush), {},
                {{0, vk::Format::eR32Uint},
                 {1, vk::Format::eR32Uint},
