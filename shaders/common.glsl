@@ -10,6 +10,24 @@
 // be indexed by constants, an indexed local array being a loop over the lanes too.
 const int GROUP = 4;  // kPixelGroup in frame_features_gpu.cpp
 
+// Invocation i's group of GROUP neighbouring pixels of one row of a width x height image:
+// row y, first column x0. False past the last group (the dispatch rounds up).
+bool rowGroup(int i, int width, int height, out int y, out int x0) {
+  int per_row = (width + GROUP - 1) / GROUP;
+  y = i / per_row;
+  x0 = (i - y * per_row) * GROUP;
+  return i < per_row * height;
+}
+
+// Invocation i's group of GROUP neighbouring rows of one column of a width x height image
+// (width counts elements: 3 per pixel for a colour image): first row y0, column x. False past
+// the last group.
+bool columnGroup(int i, int width, int height, out int y0, out int x) {
+  y0 = i / width * GROUP;
+  x = i - i / width * width;
+  return i < (height + GROUP - 1) / GROUP * width;
+}
+
 // BORDER_REPLICATE
 int clampIndex(int i, int n) { return clamp(i, 0, n - 1); }
 

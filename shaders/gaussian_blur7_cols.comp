@@ -10,8 +10,8 @@ const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
   int i = LINEAR_INVOCATION;
   int row = pc.width * 3;
-  if (i >= (pc.height + GROUP - 1) / GROUP * row) return;
-  int y0 = i / row * GROUP, xc = i - i / row * row;
+  int y0, xc;
+  if (!columnGroup(i, row, pc.height, y0, xc)) return;
   uint v[GROUP + 6];
   [[unroll]] for (int t = 0; t < GROUP + 6; ++t) v[t] = uint(src[clampIndex(y0 + t - 3, pc.height) * row + xc]);
   [[unroll]] for (int j = 0; j < GROUP; ++j) {

@@ -9,9 +9,8 @@ layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   [[unroll]] for (int ch = 0; ch < 3; ++ch) {
     uint v[GROUP + 6];
     [[unroll]] for (int t = 0; t < GROUP + 6; ++t)

@@ -10,9 +10,8 @@ uint bitsToBytes(uint v) { return (v & 1u) | ((v & 2u) << 7u) | ((v & 4u) << 14u
 
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   // Labels take 9 values (0 and 1 << b): the median is the value where the running count
   // of a 9-bin histogram first exceeds 12. The histogram of bins 1..8 is a byte per label
   // bit in two words (each count at most 25), so no per-lane array indexing. GROUP

@@ -9,9 +9,8 @@ layout(std430, binding = 2) writeonly buffer Labels { uint8_t labels[]; };
 layout(push_constant) uniform Push { int width; int height; float threshold_sq; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   // The 3x3 histograms of bins as 4-bit counts in one word each (at most 9 per bin): no
   // per-lane array indexing, which is a loop over the lanes on llvmpipe. GROUP neighbouring
   // pixels of a row (common.glsl) share the 3 x (GROUP + 2) loads.

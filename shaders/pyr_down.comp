@@ -8,9 +8,8 @@ layout(push_constant) uniform Push { int src_width; int src_height; int width; i
 const int k[5] = int[](1, 4, 6, 4, 1);
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   // GROUP neighbouring output pixels of a row (common.glsl) share the 2 GROUP + 3 source
   // columns of their windows.
   int cols[2 * GROUP + 3];

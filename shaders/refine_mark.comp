@@ -5,7 +5,7 @@
 #include "refine_grid.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
-layout(std430, binding = 1) readonly buffer State { uint unit_count; uint max_units; uint next_candidate; uint first_candidate; };
+layout(std430, binding = 1) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 2) buffer ColumnMarks { uint columns[]; };
 layout(std430, binding = 3) buffer Occupied { uint occupied[]; };  // a bit per template band
 layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;

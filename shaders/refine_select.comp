@@ -9,7 +9,7 @@ layout(binding = 0) uniform utextureBuffer blocks;  // r32ui
 layout(binding = 1) uniform utextureBuffer bases;   // r32ui
 layout(binding = 2) uniform utextureBuffer scores;  // rgba32ui, two texels per unit row
 layout(std430, binding = 3) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
-layout(std430, binding = 4) readonly buffer State { uint unit_count; uint max_units; uint next_candidate; uint first_candidate; };
+layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Results { uvec2 results[]; };
 layout(binding = 6) uniform utextureBuffer shifts;  // r32ui, per template band
 layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;
@@ -19,9 +19,6 @@ uint unitIndex(uint bit) {
   uint below = texelFetch(blocks, word).x & ((1u << (bit & 31u)) - 1u);
   return texelFetch(bases, word).x + uint(bitCount(below));
 }
-
-// Per lane, the larger of the two packed 16-bit scores.
-uvec4 halvesMax(uvec4 x) { return max(x & 0xFFFFu, x >> 16u); }
 
 // The packed scores of window row `row`: the window's columns are positions o .. o + 15 of
 // two consecutive blocks (one if o == 0) of the row's band, whose blocks start at its shift.

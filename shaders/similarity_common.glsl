@@ -1,8 +1,7 @@
 // Shared by the similarity kernels. The linear memories are read as a texel buffer of
 // 16-byte texels: on llvmpipe (lavapipe) a texel fetch is eight 16-byte loads and a
-// transpose, while a
-// storage-buffer load at a per-invocation offset becomes a branchy scalar loop over the
-// lanes, once per 32-bit component. Each feature is a byte offset into the linear memories
+// transpose, while a storage-buffer load at a per-invocation offset becomes a branchy
+// scalar loop over the lanes, once per 32-bit component. Each feature is a byte offset into the linear memories
 // (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes
 // (63 * 4 < 256), then widen into packed 16-bit lanes (packed_scores.glsl).
 #extension GL_EXT_samplerless_texture_functions : require
@@ -26,12 +25,6 @@ void widen(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
 }
 
 #include "packed_scores.glsl"
-
-// Highest of the 16 scores in `lo` and `hi`.
-uint maxOfSixteen(uvec4 lo, uvec4 hi) {
-  uvec4 m = max(max(lo & 0xFFFFu, lo >> 16u), max(hi & 0xFFFFu, hi >> 16u));
-  return max(max(m.x, m.y), max(m.z, m.w));
-}
 
 // Template header: first feature, feature count, first cell column, first cell row, raw
 // threshold, then the coarse level's columns and rows of positions (match::coarseRange),

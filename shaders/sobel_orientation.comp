@@ -9,9 +9,8 @@ layout(std430, binding = 2) writeonly buffer Mag { int magnitude[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   // GROUP neighbouring pixels of a row (common.glsl) share their 3 x (GROUP + 2) loads per
   // channel.
   int rows[3] = int[](clampIndex(y - 1, pc.height) * pc.width, y * pc.width, clampIndex(y + 1, pc.height) * pc.width);

@@ -9,8 +9,8 @@ layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
-  if (i >= (pc.height + GROUP - 1) / GROUP * pc.width) return;
-  int y0 = i / pc.width * GROUP, x = i - i / pc.width * pc.width;
+  int y0, x;
+  if (!columnGroup(i, pc.width, pc.height, y0, x)) return;
   uint acc[GROUP];
   [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0u;
   for (int t = 0; t < pc.T + GROUP - 1; ++t) {

@@ -9,9 +9,8 @@ layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
-  int per_row = (pc.width + GROUP - 1) / GROUP;
-  if (i >= per_row * pc.height) return;
-  int y = i / per_row, x0 = (i - y * per_row) * GROUP;
+  int y, x0;
+  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   uint acc[GROUP];
   [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0u;
   for (int t = 0; t < pc.T + GROUP - 1; ++t) {
