@@ -1,15 +1,29 @@
 #version 450
 // Stage 2, finer level: the scores of each unit (see refine_grid.glsl) of this chunk, BAND
 // rows of 16 positions packed as packed_scores.glsl reads them. An invocation scores a run of
-// SPAN neighbouring units (refine_units.comp): per row and feature SPAN + 1 texels.
+// SPAN neighbouring units (refine_units.comp). The finer level's linear memory holds a nibble
+// per cell (gpu::packsNibbles), so a texel is 32 positions: a row of SPAN units takes
+// TEXELS fetches per feature, where bytes took SPAN + 1, and the fetches are what cost.
 #include "similarity_common.glsl"
 #include "refine_grid.glsl"
 layout(constant_id = 0) const int SPAN = 1;
+// Texels holding 16 SPAN nibbles from any of the 32 nibble offsets of the first.
+const int TEXELS = (16 * SPAN + 30) / 32 + 1;
 layout(local_size_x = 64) in;
 layout(std430, binding = 3) readonly buffer Runs { uvec4 runs[]; };  // template band, padded column, slot
 layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Scores { uvec4 scores[]; };
 layout(push_constant) uniform Push { int stride; uint capacity; UnitGrid grid; } pc;
+
+// Byte sums of unit scores as accumulated below (x, y: positions 0, 2, .., 14 of the unit;
+// z, w: positions 1, 3, .., 15) added into the packed 16-bit totals of packed_scores.glsl
+// (lo: positions 4j and 4j + 2 in word j, hi: 4j + 1 and 4j + 3).
+uint spreadBytes(uint v) { return (v & 0xFFu) | ((v & 0xFF00u) << 8u); }
+void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
+  lo += uvec4(spreadBytes(acc.x), spreadBytes(acc.x >> 16u), spreadBytes(acc.y), spreadBytes(acc.y >> 16u));
+  hi += uvec4(spreadBytes(acc.z), spreadBytes(acc.z >> 16u), spreadBytes(acc.w), spreadBytes(acc.w >> 16u));
+}
+
 void main() {
   uint u = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
   if (u >= min(run_count[SPAN - 1], runCapacity(pc.capacity, SPAN))) return;
@@ -22,7 +36,7 @@ void main() {
   int h = t * HEADER_INTS;
   int f = headers[h], end = f + headers[h + 1];
   uint base = uint(row * pc.stride + column);
-  int row_texels = pc.stride / 16;
+  int row_texels = pc.stride / 32;
   uvec4 lo[BAND * SPAN], hi[BAND * SPAN];
   for (int i = 0; i < BAND * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
   while (f < end) {
@@ -30,20 +44,33 @@ void main() {
     uvec4 acc[BAND * SPAN];
     for (int i = 0; i < BAND * SPAN; ++i) acc[i] = uvec4(0u);
     for (; f < chunk_end; ++f) {
+      // Nibble offset of the run's first position for this feature. The stride is a
+      // multiple of 32, so every row has the same alignment: word q of the first texel,
+      // bit s of that word.
       uint off = uint(texelFetch(feature_offsets, f).x) + base;
-      // The stride is a multiple of 16, so every row has the same alignment.
-      uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
-      int first = int(off >> 4);
+      uint q = (off >> 3u) & 3u, s = (off & 7u) * 4u;
+      int first = int(off >> 5u);
       for (int r = 0; r < BAND; ++r) {
-        uvec4 x = texelFetch(memory, first + r * row_texels);
+        uint words[4 * TEXELS];
+        for (int k = 0; k < TEXELS; ++k) {
+          uvec4 x = texelFetch(memory, first + r * row_texels + k);
+          words[4 * k] = x.x;
+          words[4 * k + 1] = x.y;
+          words[4 * k + 2] = x.z;
+          words[4 * k + 3] = x.w;
+        }
+        // The run's words from word q on, then each unit's 64 bits from bit s.
+        uint v[2 * SPAN + 1];
+        for (int j = 0; j <= 2 * SPAN; ++j)
+          v[j] = q == 0u ? words[j] : q == 1u ? words[j + 1] : q == 2u ? words[j + 2] : words[j + 3];
         for (int k = 0; k < SPAN; ++k) {
-          uvec4 y = texelFetch(memory, first + r * row_texels + k + 1);
-          acc[r * SPAN + k] += alignBytes(x, y, q, s);
-          x = y;
+          uint a = v[2 * k], b = v[2 * k + 1], c = v[2 * k + 2];
+          uvec2 w = s == 0u ? uvec2(a, b) : uvec2((a >> s) | (b << (32u - s)), (b >> s) | (c << (32u - s)));
+          acc[r * SPAN + k] += uvec4(w & 0x0F0F0F0Fu, (w >> 4u) & 0x0F0F0F0Fu);
         }
       }
     }
-    for (int i = 0; i < BAND * SPAN; ++i) widen(acc[i], lo[i], hi[i]);
+    for (int i = 0; i < BAND * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
   }
   for (int k = 0; k < SPAN; ++k)
     for (int r = 0; r < BAND; ++r) {

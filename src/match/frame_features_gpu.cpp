@@ -16,8 +16,13 @@ constexpr std::size_t kPixelGroup = 4;  // GROUP in shaders/common.glsl
 // Zeros after the last plane, which the similarity kernels may read past (their values
 // never reach a score): the coarse pass fetches whole texels up to 64 bytes past a row's last
 // position, and refinement units cover 4 rows from a multiple of 4 (up to 3 rows past the
-// plane) in blocks that may end up to 31 bytes past a row.
+// plane) in blocks that may end up to 31 bytes past a row (in a nibble-packed memory, half
+// as many bytes).
 std::size_t memoryTailBytes(const LinearMemoryLayout& layout) { return 4 * static_cast<std::size_t>(layout.stride) + 64; }
+// A level's linear memory: a byte per cell, or a nibble per cell where it is packed.
+std::size_t memoryBytes(const LinearMemoryLayout& layout, bool packed) {
+  return (packed ? layout.total_bytes() / 2 : layout.total_bytes()) + memoryTailBytes(layout);
+}
 struct SizePush {
   int32_t width, height;
 };
@@ -35,8 +40,10 @@ struct FrameFeatures::Kernels {
         downsample(c, ShaderId::downsample_labels, 2, 12),
         spread_rows(c, ShaderId::spread_rows, 2, 12),
         spread(c, ShaderId::spread, 2, 12),
-        linearize(c, ShaderId::response_linearize, 2, 28) {}
-  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
+        linearize(c, ShaderId::response_linearize, 2, 28, {0}),
+        linearize_packed(c, ShaderId::response_linearize, 2, 28, {1}) {}
+  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize,
+      linearize_packed;
 };
 
 FrameFeatures::FrameFeatures(const GpuContext& ctx, const FeatureParams& params)
@@ -122,11 +129,12 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     // Linear memories: padding cells are never written, so zero the buffer only when its
     // layout changes.
     const LinearMemoryLayout& layout = layouts[l];
+    const bool packed = packsNibbles(l, layouts.size());
     const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
                       L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
-                      L.memory.size() == layout.total_bytes() + memoryTailBytes(layout);
+                      L.memory.size() == memoryBytes(layout, packed);
     if (!same) {
-      L.memory = Buffer(ctx_, layout.total_bytes() + memoryTailBytes(layout));
+      L.memory = Buffer(ctx_, memoryBytes(layout, packed));
       batch.fill(L.memory, 0u);
       L.layout = layout;
     }
@@ -138,12 +146,13 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, row_groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, column_groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
-      // One invocation per four padded cells of a pixel row and grid column
-      // (response_linearize.comp).
+      // One invocation per word of padded cells of a pixel row and grid column: 4 cells,
+      // or 8 where packed (response_linearize.comp).
       const int cells_x = (L.size.width + layout.T - 1) / layout.T;
-      const auto quads = static_cast<std::size_t>((layout.pad + cells_x + 3) / 4 - layout.pad / 4);
-      batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
-                           groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * quads,
+      const int per_word = packed ? 8 : 4;
+      const auto words = static_cast<std::size_t>((layout.pad + cells_x + per_word - 1) / per_word - layout.pad / per_word);
+      batch.dispatchLinear(packed ? k.linearize_packed : k.linearize, {L.spread, L.memory}, lpush,
+                           groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * words,
                                      kGroup));
     }
   }

@@ -30,7 +30,8 @@ std::array<cv::Mat, 8> computeResponseMaps(const cv::Mat& spread) {
   return maps;
 }
 
-LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells) {
+LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells,
+                                          int stride_multiple) {
   LinearMemoryLayout l;
   l.T = T;
   l.width = width;
@@ -41,7 +42,8 @@ LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_
   // refinement windows reach `extra_cells` further. Right/bottom: the full template, the
   // window and one 16-cell block of overrun.
   l.pad = max_template_cells / 2 + extra_cells + 1;
-  l.stride = (l.pad + l.cells_x + max_template_cells + extra_cells + 16 + 4 + 15) / 16 * 16;
+  l.stride = (l.pad + l.cells_x + max_template_cells + extra_cells + 16 + 4 + stride_multiple - 1) / stride_multiple *
+             stride_multiple;
   l.rows = l.pad + l.cells_y + max_template_cells + extra_cells + 1;
   return l;
 }
