@@ -23,10 +23,15 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
                                  const MatchParams& params) {
   const std::size_t coarse = fp.T.size() - 1;
   const int Tc = fp.T[coarse];
+  // The scoring level's feature count of each template, gathered once: a frame can have
+  // hundreds of thousands of candidates (nine in ten fail refinement), and reaching each
+  // template's features through its levels would cost a few cache misses per candidate.
+  std::vector<int> feature_counts(templates.size());
+  for (std::size_t t = 0; t < templates.size(); ++t) feature_counts[t] = featureCount(templates[t], 0);
   std::vector<Match> out;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const auto& cand = candidates[i];
-    const auto& t = templates[static_cast<std::size_t>(cand.template_id)];
+    const int features = feature_counts[static_cast<std::size_t>(cand.template_id)];
     Match m;
     m.template_id = cand.template_id;
     if (coarse == 0) {
@@ -34,7 +39,7 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
       m.x = cand.c * Tc + positionOffset(Tc);
       m.y = cand.r * Tc + positionOffset(Tc);
       m.raw_score = cand.score;
-      m.similarity = similarityPercent(cand.score, featureCount(t, 0)) + 0.5f;
+      m.similarity = similarityPercent(cand.score, features) + 0.5f;
     } else {
       const auto& ref = refined[i];
       if (ref.score == 0) continue;
@@ -42,7 +47,7 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
       m.x = (refineWindowStart(cand.c, Tc, Tf) + ref.best_c) * Tf + positionOffset(Tf);
       m.y = (refineWindowStart(cand.r, Tc, Tf) + ref.best_r) * Tf + positionOffset(Tf);
       m.raw_score = ref.score;
-      m.similarity = similarityPercent(ref.score, featureCount(t, 0));
+      m.similarity = similarityPercent(ref.score, features);
       if (m.similarity < params.threshold) continue;
     }
     out.push_back(m);
