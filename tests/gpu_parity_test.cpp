@@ -1,5 +1,7 @@
 // GPU kernels == CPU reference, bit for bit, for every integer stage: label images of both
 // modalities at every level, the linear memories, and the matches.
+#include <cstdlib>
+
 #include "gpu/batch.hpp"
 #include "match/frame_features_gpu.hpp"
 #include "match/match_geometry.hpp"
@@ -119,10 +121,25 @@ TEST(GpuParity, MatchesOnRealFramesBothModalities) {
 }
 
 TEST(GpuParity, MatchesAcrossSeveralTemplateChunks) {
-  // Over 1,849 templates the GPU matcher splits them into chunks (the unit scores of a
-  // chunk must fit one binding): 60 copies of 40 templates cross that boundary.
+  // A chunk takes up to 16,384 templates; when its refinement units outgrow one binding of
+  // unit scores, the matcher halves the chunks and runs the frame again. A low limit on the
+  // units (VKPOSE_MAX_REFINE_UNITS) makes 60 copies of 40 templates split several times.
   VKPOSE_REQUIRE_SHARED_DATA();
+  struct LowUnitLimit {
+    LowUnitLimit() { ::setenv("VKPOSE_MAX_REFINE_UNITS", "3000", 1); }
+    ~LowUnitLimit() { ::unsetenv("VKPOSE_MAX_REFINE_UNITS"); }
+  } limit;
   expectMatchParity(test::lmoFrame(), {}, 40, 92.0f, 60);
+  auto templates = test::templatesFrom(test::lmoFrame(), {}, 40);
+  const auto originals = templates;
+  for (int c = 1; c < 60; ++c) templates.insert(templates.end(), originals.begin(), originals.end());
+  MatchParams mp;
+  mp.threshold = 92.0f;
+  LinemodMatcher matcher(test::context(), {}, mp);
+  matcher.setTemplates(templates);
+  matcher.match(test::lmoFrame());
+  EXPECT_GT(matcher.lastTimings().chunks, 1u);
+  EXPECT_GT(matcher.lastTimings().attempts, matcher.lastTimings().passes);
 }
 
 TEST(GpuParity, MatchesWithOneModalityAndOneLevel) {

@@ -49,6 +49,9 @@ struct MatchTimings {
   /// Similarity submits including those that overflowed and were run again (passes when
   /// none did): each overflow costs a pass's work.
   std::size_t attempts = 0;
+  /// Template chunks (up to 16,384 templates each; fewer when a chunk's refinement outgrew
+  /// a GPU buffer and the chunks were halved).
+  std::size_t chunks = 0;
 };
 
 namespace gpu {

@@ -54,7 +54,7 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
   // (many banks at a low threshold): then passes over fewer chunks each, features computed
   // once. A frame starts with the pass size the last one ended with: an overflowing pass
   // costs as much as one that fits.
-  const std::size_t chunks = similarity_->chunkCount();
+  std::size_t chunks = similarity_->chunkCount();
   std::size_t per_pass = chunks_per_pass_ > 0 ? std::min(chunks_per_pass_, chunks) : chunks;
   std::size_t most_candidates = 0;  // of one pass
   // Features in a submit of their own (timed apart from similarity; they stay on the device).
@@ -78,6 +78,22 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
       ++timings_.passes;
       continue;
     }
+    if (similarity_->unitsFull()) {
+      // A chunk's refinement outgrew a binding: the templates again in smaller chunks, and
+      // the frame's passes from the start (its features stay).
+      if (!similarity_->splitChunks())
+        throw DeviceError("one template's refinement needs more units than a GPU buffer holds; raise the match threshold");
+      similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_);
+      batch.submit();
+      chunks = similarity_->chunkCount();
+      per_pass = chunks;
+      candidates.clear();
+      refined.clear();
+      most_candidates = 0;
+      begin = 0;
+      attempt = 0;
+      continue;
+    }
     if (similarity_->full()) {
       if (end - begin == 1)
         throw DeviceError("one template chunk finds more candidates than a GPU buffer holds; raise the match threshold");
@@ -89,6 +105,7 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
   // Passes that stayed under half a binding could cover twice the chunks next time.
   chunks_per_pass_ = most_candidates < similarity_->maxCandidates() / 2 ? std::min(chunks, 2 * per_pass) : per_pass;
   t0 = std::chrono::steady_clock::now();
+  timings_.chunks = chunks;
   timings_.coarse_candidates = candidates.size();
   auto matches = match::finishMatches(candidates, refined, templates_, feature_params_, params_);
   timings_.finish_ms = msSince(t0);

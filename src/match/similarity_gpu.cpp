@@ -1,5 +1,6 @@
 #include "match/similarity_gpu.hpp"
 
+#include <cstdlib>
 #include <cstring>
 
 #include "match/frame_features_gpu.hpp"
@@ -118,9 +119,11 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   layouts_ = layouts;
   chunks_.clear();
   const std::size_t levels = layouts.size();
-  // Chunks: at most 65535 templates (workgroup rows), features that fit one binding, and
-  // with refinement as many templates as the unit scores of one binding can hold even if
-  // every unit of every template is covered.
+  // Chunks: at most 16384 templates (workgroup rows) and features that fit one binding.
+  // Each chunk is some 14 dispatches, each a barrier on llvmpipe, so chunks are as large as
+  // that allows; should one chunk's refinement units outgrow a binding of unit scores (a
+  // frame where templates match nearly everywhere), read() says so and the matcher lays the
+  // templates out again in chunks half the size (splitChunks).
   const auto& dev = ctx_.device();
   const std::size_t max_bytes = std::min<std::size_t>(dev.max_storage_buffer_range, 64u << 20);
   // A candidate takes 16 bytes (after a 16-byte count) and its result 8: many banks at once can
@@ -128,16 +131,18 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   // passes, so chunks are kept to 16384 templates for the split to have something to split.
   max_capacity_ = static_cast<uint32_t>(std::min<std::size_t>((dev.max_storage_buffer_range - 16) / 16, 1u << 30));
   capacity_ = std::min(capacity_, max_capacity_);
-  std::size_t max_templates = 16384;
-  std::size_t units_per_template = 0;
+  const std::size_t max_templates = std::min<std::size_t>(16384, chunk_templates_);
+  std::size_t units_per_template = 0, binding_units = 0;
   if (levels > 1) {
     const auto& fl = layouts[0];
     units_per_template = static_cast<std::size_t>((fl.rows + kUnitBand - 1) / kUnitBand) *
                          static_cast<std::size_t>(fl.stride / match::kRefineWindow);
-    const std::size_t max_units =
+    binding_units =
         std::min<std::size_t>({dev.max_storage_buffer_range, dev.max_texel_buffer_elements * 16, 1u << 30}) /
         kUnitScoreBytes;
-    max_templates = std::clamp<std::size_t>(max_units / units_per_template, 1, max_templates);
+    // Tests lower it to reach the chunk split with a small bank.
+    if (const char* env = std::getenv("VKPOSE_MAX_REFINE_UNITS"); env && std::atoll(env) > 0)
+      binding_units = std::min<std::size_t>(binding_units, static_cast<std::size_t>(std::atoll(env)));
   }
   std::size_t t = 0;
   std::size_t largest = 0;
@@ -187,7 +192,7 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
     template_bands_ = largest * static_cast<std::size_t>(grid.bands);
     block_words_ = template_bands_ * static_cast<std::size_t>(grid.words_per_band);
     column_words_ = template_bands_ * static_cast<std::size_t>(grid.column_words);
-    max_unit_capacity_ = static_cast<uint32_t>(largest * units_per_template);
+    max_unit_capacity_ = static_cast<uint32_t>(std::min(largest * units_per_template, binding_units));
     unit_capacity_ = std::min(unit_capacity_, max_unit_capacity_);
   }
 }
@@ -243,6 +248,14 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
   }
 }
 
+bool Similarity::splitChunks() {
+  int largest = 0;
+  for (const auto& c : chunks_) largest = std::max(largest, c.template_count);
+  if (largest <= 1) return false;
+  chunk_templates_ = static_cast<std::size_t>(largest / 2);
+  return true;
+}
+
 bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined) {
   const auto* words = static_cast<const uint32_t*>(candidates_.mapped());
   const uint32_t count = words[0];
@@ -256,9 +269,11 @@ bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vect
         std::min<uint64_t>(std::max<uint64_t>(count + uint64_t{count} / 4, uint64_t{capacity_} * 2), max_capacity_));
     complete = false;
   }
+  units_full_ = false;
   if (layouts_.size() > 1) {
     const uint32_t max_units = static_cast<const uint32_t*>(state_.mapped())[1];
     if (max_units > unit_capacity_) {
+      units_full_ = unit_capacity_ == max_unit_capacity_;
       unit_capacity_ = std::min(std::max(max_units + max_units / 4, unit_capacity_ * 2), max_unit_capacity_);
       complete = false;
     }

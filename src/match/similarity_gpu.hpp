@@ -35,6 +35,11 @@ class Similarity {
   /// must cover fewer chunks.
   bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
   bool full() const { return full_; }
+  /// After a read() that returned false: a chunk's refinement units outgrew one binding of
+  /// unit scores. splitChunks() halves the chunks (false when they are single templates
+  /// already); setTemplates() must then lay the templates out again.
+  bool unitsFull() const { return units_full_; }
+  bool splitChunks();
   /// Candidates one pass can hold at most (one binding's worth).
   std::size_t maxCandidates() const { return max_capacity_; }
 
@@ -53,8 +58,10 @@ class Similarity {
   uint32_t capacity_ = 1u << 16;       // candidate slots
   uint32_t max_capacity_ = 0;          // candidate slots one binding can hold
   bool full_ = false;                  // the last pass overflowed max_capacity_
+  bool units_full_ = false;            // the last pass overflowed max_unit_capacity_
+  std::size_t chunk_templates_ = 16384;  // most templates of a chunk
   uint32_t unit_capacity_ = 1u << 16;  // unit slots of one chunk
-  uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk
+  uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk, or one binding's worth
   std::size_t template_bands_ = 0;     // template bands of the largest chunk
   std::size_t block_words_ = 0;        // and its block mark words
   std::size_t column_words_ = 0;       // and its column mark words
