@@ -2,15 +2,12 @@
 // Response maps (quantized cosine: 4 - circular bin distance to the nearest spread
 // orientation) written straight into the padded linear memories of one modality. An
 // invocation takes CELLS neighbouring cells of one pixel row and grid column (the pixels
-// x, x + T, x + 2T, ...) and writes each bin's responses as one word: a byte store is a loop
-// over the lanes on llvmpipe, and far fewer of them pay. The coarsest level keeps a byte per
-// cell (CELLS = 4); the finer levels, read only by refinement, pack a nibble per cell
-// (CELLS = 8, PACKED): responses are 0..4, and half the bytes to fetch is what pays there
-// (similarity_refine.comp).
+// x, x + T, x + 2T, ...) and writes each bin's responses as one word, a nibble per cell
+// (responses are 0..4; similarity_common.glsl reads them): a byte store is a loop over the
+// lanes on llvmpipe, and far fewer of them pay.
 #include "common.glsl"
-layout(constant_id = 0) const bool PACKED = false;
-const int CELLS = PACKED ? 8 : 4;
-const uint BITS = PACKED ? 4u : 8u;
+const int CELLS = 8;
+const uint BITS = 4u;
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Spread { uint8_t spread[]; };
 layout(std430, binding = 1) writeonly buffer Memory { uint memory[]; };
@@ -20,7 +17,7 @@ layout(push_constant) uniform Push {
 void main() {
   int i = LINEAR_INVOCATION;
   // Word-aligned groups of CELLS padded cells that hold image cells (the stride, and so the
-  // plane size, is a multiple of 16 cells, of 32 where packed).
+  // plane size, is a multiple of 32 cells).
   int first_group = pc.pad / CELLS;
   int cells_x = (pc.width + pc.T - 1) / pc.T;
   int groups = (pc.pad + cells_x + CELLS - 1) / CELLS - first_group;

@@ -2,19 +2,20 @@
 // Stage 2, coarse level: every template (workgroup row y) at every cell position of its
 // range (match::coarseRange); positions over the template's raw threshold are
 // appended to the candidate list. An invocation scores ROWS rows of SPAN blocks of 16
-// positions: per row and feature SPAN + 1 texels, where a lane per block would fetch two
-// each (the fetches are what the pass costs on llvmpipe).
+// positions: per row and feature TEXELS texels of 32 nibbles, where a lane per block would
+// fetch two each (the fetches are what the pass costs on llvmpipe).
 #include "similarity_common.glsl"
 layout(local_size_x = 16) in;  // kCoarseGroup in similarity_gpu.cpp
 layout(std430, binding = 3) buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(push_constant) uniform Push {
   int template_base;  // global id of this chunk's first template
-  int stride;         // bytes per linear-memory row (a multiple of 16)
+  int stride;         // cells per linear-memory row (a multiple of 32)
   uint capacity;      // candidate slots
 } pc;
 const int ROWS = 2;  // match kCoarseRows in similarity_gpu.cpp
 const int SPAN = 3;  // match kCoarseSpan in similarity_gpu.cpp
-const uint LAST_OF_GROUP = 1u << 30;  // match kLastOfGroup in similarity_gpu.cpp
+// Texels holding 16 SPAN nibbles from any of the 32 nibble offsets of the first.
+const int TEXELS = (16 * SPAN + 30) / 32 + 1;
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
   int t = int(gl_WorkGroupID.y);
@@ -29,29 +30,35 @@ void main() {
   int c0 = headers[h + 2] + span * 16 * SPAN;
   int f = headers[h], end = f + headers[h + 1];
   uint base = uint(r0 * pc.stride + c0);
-  int row_texels = pc.stride / 16;
+  int row_texels = pc.stride / 32;
   uvec4 lo[ROWS * SPAN], hi[ROWS * SPAN];
   for (int i = 0; i < ROWS * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
-  // The features come in groups of one read alignment (at most 63, the last one flagged;
-  // setTemplates): a group's raw texels add up, byte sums that never carry, so they are
-  // aligned once per group instead of once per feature.
   while (f < end) {
-    uvec4 raw[ROWS * (SPAN + 1)];
-    for (int i = 0; i < ROWS * (SPAN + 1); ++i) raw[i] = uvec4(0u);
-    uint off, word;
-    do {
-      word = uint(texelFetch(feature_offsets, f).x);
-      off = (word & ~LAST_OF_GROUP) + base;
-      // The stride is a multiple of 16, so every row has the same alignment.
-      int first = int(off >> 4);
-      for (int r = 0; r < ROWS; ++r)
-        for (int k = 0; k <= SPAN; ++k) raw[r * (SPAN + 1) + k] += texelFetch(memory, first + r * row_texels + k);
-      ++f;
-    } while ((word & LAST_OF_GROUP) == 0u);
-    uint q = (off >> 2) & 3u, s = (off & 3u) * 8u;
-    for (int r = 0; r < ROWS; ++r)
-      for (int k = 0; k < SPAN; ++k)
-        widen(alignBytes(raw[r * (SPAN + 1) + k], raw[r * (SPAN + 1) + k + 1], q, s), lo[r * SPAN + k], hi[r * SPAN + k]);
+    int chunk_end = min(f + 63, end);
+    uvec4 acc[ROWS * SPAN];
+    for (int i = 0; i < ROWS * SPAN; ++i) acc[i] = uvec4(0u);
+    for (; f < chunk_end; ++f) {
+      // Nibble offset of the first position for this feature (the stride is a multiple of
+      // 32, so every row has the same alignment): word q of the first texel, bit s of it.
+      uint off = uint(texelFetch(feature_offsets, f).x) + base;
+      uint q = (off >> 3u) & 3u, s = (off & 7u) * 4u;
+      int first = int(off >> 5u);
+      for (int r = 0; r < ROWS; ++r) {
+        uint words[4 * TEXELS];
+        for (int k = 0; k < TEXELS; ++k) {
+          uvec4 x = texelFetch(memory, first + r * row_texels + k);
+          words[4 * k] = x.x;
+          words[4 * k + 1] = x.y;
+          words[4 * k + 2] = x.z;
+          words[4 * k + 3] = x.w;
+        }
+        // The row's words from word q on, then each block's 64 bits from bit s.
+        uint v[2 * SPAN + 1];
+        for (int j = 0; j <= 2 * SPAN; ++j) v[j] = wordAt(words[j], words[j + 1], words[j + 2], words[j + 3], q);
+        for (int k = 0; k < SPAN; ++k) acc[r * SPAN + k] += nibbleBlock(v[2 * k], v[2 * k + 1], v[2 * k + 2], s);
+      }
+    }
+    for (int i = 0; i < ROWS * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
   }
   uint threshold = uint(headers[h + 4]);
   // Few positions pass. llvmpipe runs both sides of every `if` under a lane mask, so the

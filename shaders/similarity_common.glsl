@@ -1,27 +1,32 @@
 // Shared by the similarity kernels. The linear memories are read as a texel buffer of
 // 16-byte texels: on llvmpipe (lavapipe) a texel fetch is eight 16-byte loads and a
 // transpose, while a storage-buffer load at a per-invocation offset becomes a branchy
-// scalar loop over the lanes, once per 32-bit component. Each feature is a byte offset into the linear memories
-// (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes
-// (63 * 4 < 256), then widen into packed 16-bit lanes (packed_scores.glsl).
+// scalar loop over the lanes, once per 32-bit component. The memories hold a nibble per
+// cell (responses are 0..4), 32 cells a texel: the fetches, not the arithmetic, set the
+// pace, and nibbles halve them. Each feature is a cell (nibble) offset into the linear
+// memories (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes,
+// then widen into packed 16-bit lanes (packed_scores.glsl).
 #extension GL_EXT_samplerless_texture_functions : require
 layout(binding = 0) uniform utextureBuffer memory;
 layout(binding = 2) uniform itextureBuffer feature_offsets;  // r32i
 
-// The 16 bytes at byte `q * 4 + s / 8` of the 32 in texels x, y: their words picked and
-// funnel-shifted into alignment. A feature's 16 responses at byte offset `off` are those
-// of texels off / 16 and off / 16 + 1, so a row of L blocks of 16 positions takes L + 1
-// texels; the layouts' right and bottom margins keep the last one inside the buffer.
-uvec4 alignBytes(uvec4 x, uvec4 y, uint q, uint s) {
-  uvec4 a = q == 0u ? x : q == 1u ? uvec4(x.yzw, y.x) : q == 2u ? uvec4(x.zw, y.xy) : uvec4(x.w, y.xyz);
-  uint e = q == 0u ? y.x : q == 1u ? y.y : q == 2u ? y.z : y.w;
-  return s == 0u ? a : (a >> s) | (uvec4(a.yzw, e) << (32u - s));
+// Word q (0..3) of the four from w0 on.
+uint wordAt(uint w0, uint w1, uint w2, uint w3, uint q) { return q == 0u ? w0 : q == 1u ? w1 : q == 2u ? w2 : w3; }
+
+// The 16 cells of a block, 64 bits from bit s (a multiple of 4) of word a on (b and c the
+// next words), as byte sums to add: cells 0, 2, .., 14 in x and y, cells 1, 3, .., 15 in z
+// and w. Up to 63 features add up without a carry (63 * 4 < 256).
+uvec4 nibbleBlock(uint a, uint b, uint c, uint s) {
+  uvec2 w = s == 0u ? uvec2(a, b) : uvec2((a >> s) | (b << (32u - s)), (b >> s) | (c << (32u - s)));
+  return uvec4(w & 0x0F0F0F0Fu, (w >> 4u) & 0x0F0F0F0Fu);
 }
 
-// Widens packed byte sums into the packed 16-bit totals.
-void widen(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
-  lo += acc & 0x00FF00FFu;
-  hi += (acc >> 8u) & 0x00FF00FFu;
+// Byte sums as nibbleBlock leaves them added into the packed 16-bit totals of
+// packed_scores.glsl (lo: cells 4j and 4j + 2 in word j, hi: 4j + 1 and 4j + 3).
+uint spreadBytes(uint v) { return (v & 0xFFu) | ((v & 0xFF00u) << 8u); }
+void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
+  lo += uvec4(spreadBytes(acc.x), spreadBytes(acc.x >> 16u), spreadBytes(acc.y), spreadBytes(acc.y >> 16u));
+  hi += uvec4(spreadBytes(acc.z), spreadBytes(acc.z >> 16u), spreadBytes(acc.w), spreadBytes(acc.w >> 16u));
 }
 
 #include "packed_scores.glsl"

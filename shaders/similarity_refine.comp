@@ -1,9 +1,8 @@
 #version 450
 // Stage 2, finer level: the scores of each unit (see refine_grid.glsl) of this chunk, BAND
 // rows of 16 positions packed as packed_scores.glsl reads them. An invocation scores a run of
-// SPAN neighbouring units (refine_units.comp). The finer level's linear memory holds a nibble
-// per cell (gpu::packsNibbles), so a texel is 32 positions: a row of SPAN units takes
-// TEXELS fetches per feature, where bytes took SPAN + 1, and the fetches are what cost.
+// SPAN neighbouring units (refine_units.comp): a row of them takes TEXELS fetches of 32
+// nibbles per feature.
 #include "similarity_common.glsl"
 #include "refine_grid.glsl"
 layout(constant_id = 0) const int SPAN = 1;
@@ -14,15 +13,6 @@ layout(std430, binding = 3) readonly buffer Runs { uvec4 runs[]; };  // template
 layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Scores { uvec4 scores[]; };
 layout(push_constant) uniform Push { int stride; uint capacity; UnitGrid grid; } pc;
-
-// Byte sums of unit scores as accumulated below (x, y: positions 0, 2, .., 14 of the unit;
-// z, w: positions 1, 3, .., 15) added into the packed 16-bit totals of packed_scores.glsl
-// (lo: positions 4j and 4j + 2 in word j, hi: 4j + 1 and 4j + 3).
-uint spreadBytes(uint v) { return (v & 0xFFu) | ((v & 0xFF00u) << 8u); }
-void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
-  lo += uvec4(spreadBytes(acc.x), spreadBytes(acc.x >> 16u), spreadBytes(acc.y), spreadBytes(acc.y >> 16u));
-  hi += uvec4(spreadBytes(acc.z), spreadBytes(acc.z >> 16u), spreadBytes(acc.w), spreadBytes(acc.w >> 16u));
-}
 
 void main() {
   uint u = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
@@ -61,13 +51,8 @@ void main() {
         }
         // The run's words from word q on, then each unit's 64 bits from bit s.
         uint v[2 * SPAN + 1];
-        for (int j = 0; j <= 2 * SPAN; ++j)
-          v[j] = q == 0u ? words[j] : q == 1u ? words[j + 1] : q == 2u ? words[j + 2] : words[j + 3];
-        for (int k = 0; k < SPAN; ++k) {
-          uint a = v[2 * k], b = v[2 * k + 1], c = v[2 * k + 2];
-          uvec2 w = s == 0u ? uvec2(a, b) : uvec2((a >> s) | (b << (32u - s)), (b >> s) | (c << (32u - s)));
-          acc[r * SPAN + k] += uvec4(w & 0x0F0F0F0Fu, (w >> 4u) & 0x0F0F0F0Fu);
-        }
+        for (int j = 0; j <= 2 * SPAN; ++j) v[j] = wordAt(words[j], words[j + 1], words[j + 2], words[j + 3], q);
+        for (int k = 0; k < SPAN; ++k) acc[r * SPAN + k] += nibbleBlock(v[2 * k], v[2 * k + 1], v[2 * k + 2], s);
       }
     }
     for (int i = 0; i < BAND * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);

@@ -28,19 +28,17 @@ void expectFeatureParity(const LinemodFrame& frame, const FeatureParams& params,
   features.downloadLabels(batch, gpu_levels);
   std::vector<std::vector<uint8_t>> gpu_memory(layouts.size());
   for (std::size_t l = 0; l < layouts.size(); ++l) {
-    const bool packed = gpu::packsNibbles(l, layouts.size());
-    gpu_memory[l].resize(packed ? layouts[l].total_bytes() / 2 : layouts[l].total_bytes());
+    gpu_memory[l].resize(layouts[l].total_bytes() / 2);
     batch.download(features.memory(l), gpu_memory[l].data(), gpu_memory[l].size());
   }
   batch.submit();
-  // The finer levels' memories hold a nibble per cell: back to a byte per cell, as the
-  // reference writes them.
-  for (std::size_t l = 0; l < layouts.size(); ++l)
-    if (gpu::packsNibbles(l, layouts.size())) {
-      std::vector<uint8_t> cells(layouts[l].total_bytes());
-      for (std::size_t c = 0; c < cells.size(); ++c) cells[c] = (gpu_memory[l][c / 2] >> (4 * (c % 2))) & 0xF;
-      gpu_memory[l] = std::move(cells);
-    }
+  // The GPU memories hold a nibble per cell: back to a byte per cell, as the reference
+  // writes them.
+  for (std::size_t l = 0; l < layouts.size(); ++l) {
+    std::vector<uint8_t> cells(layouts[l].total_bytes());
+    for (std::size_t c = 0; c < cells.size(); ++c) cells[c] = (gpu_memory[l][c / 2] >> (4 * (c % 2))) & 0xF;
+    gpu_memory[l] = std::move(cells);
+  }
   for (std::size_t l = 0; l < reference.size(); ++l) {
     for (int m = 0; m < kModalityCount; ++m) {
       if (reference[l].labels[m].empty()) continue;

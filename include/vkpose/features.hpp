@@ -101,7 +101,7 @@ struct LinearMemoryLayout {
   int width = 0, height = 0;              ///< image size at this level, pixels
   int cells_x = 0, cells_y = 0;           ///< ceil(width / T), ceil(height / T)
   int pad = 0;                            ///< zero cells left of and above the image
-  int stride = 0;                         ///< cells per padded row (a multiple of 16)
+  int stride = 0;                         ///< cells per padded row (a multiple of 32)
   int rows = 0;                           ///< padded rows per plane
   std::size_t plane_bytes() const { return static_cast<std::size_t>(stride) * rows; }
   std::size_t modality_bytes() const { return plane_bytes() * 8 * T * T; }
@@ -115,11 +115,8 @@ struct LinearMemoryLayout {
 };
 
 /// A layout for a level of `width` x `height` pixels whose templates span at most
-/// `max_template_cells` cells in x or y; `extra_cells` more margin for local refinement. The
-/// stride is a multiple of `stride_multiple` cells (16, or 32 for a level kept a nibble per
-/// cell, so that its rows too start at one 16-byte alignment).
-LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells,
-                                          int stride_multiple = 16);
+/// `max_template_cells` cells in x or y; `extra_cells` more margin for local refinement.
+LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells);
 
 /// Writes the 8 response maps of `modality` into `memory` (layout.total_bytes(), zeroed by
 /// the caller) in the linearized order of `layout`.

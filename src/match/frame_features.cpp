@@ -142,8 +142,7 @@ std::vector<LinearMemoryLayout> makeLayouts(const std::vector<LinemodTemplate>& 
                                           templateCells(t.levels[l + 1].height, params.T[l + 1]));
         max_cells = std::max(max_cells, (coarse_cells * params.T[l + 1] * 2 + T - 1) / T + 1);
       }
-    // Finer levels keep a nibble per cell on the GPU (gpu::packsNibbles): rows 32 cells apart.
-    layouts.push_back(makeLinearMemoryLayout(sizes[l].width, sizes[l].height, T, max_cells, extra, l + 1 < sizes.size() ? 32 : 16));
+    layouts.push_back(makeLinearMemoryLayout(sizes[l].width, sizes[l].height, T, max_cells, extra));
   }
   return layouts;
 }

@@ -16,13 +16,11 @@ constexpr std::size_t kPixelGroup = 4;  // GROUP in shaders/common.glsl
 // Zeros after the last plane, which the similarity kernels may read past (their values
 // never reach a score): the coarse pass fetches whole texels up to 64 bytes past a row's last
 // position, and refinement units cover 4 rows from a multiple of 4 (up to 3 rows past the
-// plane) in blocks that may end up to 31 bytes past a row (in a nibble-packed memory, half
-// as many bytes).
+// plane) in blocks that may end up to 31 bytes past a row (counted in bytes per cell: the
+// nibbles need half).
 std::size_t memoryTailBytes(const LinearMemoryLayout& layout) { return 4 * static_cast<std::size_t>(layout.stride) + 64; }
-// A level's linear memory: a byte per cell, or a nibble per cell where it is packed.
-std::size_t memoryBytes(const LinearMemoryLayout& layout, bool packed) {
-  return (packed ? layout.total_bytes() / 2 : layout.total_bytes()) + memoryTailBytes(layout);
-}
+// A level's linear memory: a nibble per cell (the stride is a multiple of 32 cells).
+std::size_t memoryBytes(const LinearMemoryLayout& layout) { return layout.total_bytes() / 2 + memoryTailBytes(layout); }
 struct SizePush {
   int32_t width, height;
 };
@@ -40,10 +38,8 @@ struct FrameFeatures::Kernels {
         downsample(c, ShaderId::downsample_labels, 2, 12),
         spread_rows(c, ShaderId::spread_rows, 2, 12),
         spread(c, ShaderId::spread, 2, 12),
-        linearize(c, ShaderId::response_linearize, 2, 28, {0}),
-        linearize_packed(c, ShaderId::response_linearize, 2, 28, {1}) {}
-  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize,
-      linearize_packed;
+        linearize(c, ShaderId::response_linearize, 2, 28) {}
+  Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
 FrameFeatures::FrameFeatures(const GpuContext& ctx, const FeatureParams& params)
@@ -129,12 +125,11 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     // Linear memories: padding cells are never written, so zero the buffer only when its
     // layout changes.
     const LinearMemoryLayout& layout = layouts[l];
-    const bool packed = packsNibbles(l, layouts.size());
     const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
                       L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
-                      L.memory.size() == memoryBytes(layout, packed);
+                      L.memory.size() == memoryBytes(layout);
     if (!same) {
-      L.memory = Buffer(ctx_, memoryBytes(layout, packed));
+      L.memory = Buffer(ctx_, memoryBytes(layout));
       batch.fill(L.memory, 0u);
       L.layout = layout;
     }
@@ -146,12 +141,11 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, row_groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, column_groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
-      // One invocation per word of padded cells of a pixel row and grid column: 4 cells,
-      // or 8 where packed (response_linearize.comp).
+      // One invocation per word (8 padded cells) of a pixel row and grid column
+      // (response_linearize.comp).
       const int cells_x = (L.size.width + layout.T - 1) / layout.T;
-      const int per_word = packed ? 8 : 4;
-      const auto words = static_cast<std::size_t>((layout.pad + cells_x + per_word - 1) / per_word - layout.pad / per_word);
-      batch.dispatchLinear(packed ? k.linearize_packed : k.linearize, {L.spread, L.memory}, lpush,
+      const auto words = static_cast<std::size_t>((layout.pad + cells_x + 7) / 8 - layout.pad / 8);
+      batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
                            groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * words,
                                      kGroup));
     }

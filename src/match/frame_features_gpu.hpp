@@ -10,12 +10,6 @@
 
 namespace vkpose::gpu {
 
-/// Whether pyramid level `level` of `levels` keeps its linear memory a nibble per cell
-/// rather than a byte: the finer levels, which only refinement reads. Responses are 0..4,
-/// and there the texel fetches, not the arithmetic, set the pace (similarity_refine.comp).
-/// Cell c of a plane is then bits 4 (c % 2) .. of byte c / 2.
-inline bool packsNibbles(std::size_t level, std::size_t levels) { return level + 1 < levels; }
-
 class FrameFeatures {
  public:
   FrameFeatures(const GpuContext& ctx, const FeatureParams& params);
@@ -25,7 +19,9 @@ class FrameFeatures {
   void record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts);
 
   const Buffer& labels(std::size_t level, int modality) const { return levels_[level].labels[modality]; }
-  /// Linear memory of a level: a byte per cell, or a nibble per cell (packsNibbles).
+  /// Linear memory of a level, a nibble per cell (responses are 0..4): cell c of the layout
+  /// is bits 4 (c % 2) .. 4 (c % 2) + 3 of byte c / 2. The similarity kernels' texel fetches,
+  /// not their arithmetic, set their pace, and nibbles halve the fetches.
   const Buffer& memory(std::size_t level) const { return levels_[level].memory; }
   cv::Size size(std::size_t level) const { return levels_[level].size; }
 

@@ -30,8 +30,7 @@ std::array<cv::Mat, 8> computeResponseMaps(const cv::Mat& spread) {
   return maps;
 }
 
-LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells,
-                                          int stride_multiple) {
+LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells) {
   LinearMemoryLayout l;
   l.T = T;
   l.width = width;
@@ -42,8 +41,9 @@ LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_
   // refinement windows reach `extra_cells` further. Right/bottom: the full template, the
   // window and one 16-cell block of overrun.
   l.pad = max_template_cells / 2 + extra_cells + 1;
-  l.stride = (l.pad + l.cells_x + max_template_cells + extra_cells + 16 + 4 + stride_multiple - 1) / stride_multiple *
-             stride_multiple;
+  // A multiple of 32 cells: with a nibble per cell on the GPU, every row starts at one
+  // 16-byte alignment.
+  l.stride = (l.pad + l.cells_x + max_template_cells + extra_cells + 16 + 4 + 31) / 32 * 32;
   l.rows = l.pad + l.cells_y + max_template_cells + extra_cells + 1;
   return l;
 }

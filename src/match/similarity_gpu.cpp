@@ -60,25 +60,6 @@ struct ChunkPush {  // refine_mark, refine_select
   UnitGrid grid;
 };
 
-// The coarse kernel adds the raw texels of features whose reads share an alignment and
-// aligns each group's sum once (similarity_coarse.comp): a template's coarse feature
-// offsets sorted by that alignment (a coarse invocation starts at column c_lo + 48 k, and
-// rows are multiples of 16 bytes apart), in groups of at most 63 (8-bit sums), the last
-// offset of each group flagged.
-constexpr int32_t kLastOfGroup = 1 << 30;  // LAST_OF_GROUP there
-void groupByAlignment(std::vector<int32_t>::iterator begin, std::vector<int32_t>::iterator end, int c_lo) {
-  const auto alignment = [c_lo](int32_t offset) { return (offset + c_lo) & 15; };
-  std::stable_sort(begin, end, [&](int32_t a, int32_t b) { return alignment(a) < alignment(b); });
-  int in_group = 0;
-  for (auto it = begin; it != end; ++it) {
-    ++in_group;
-    if (std::next(it) == end || alignment(*std::next(it)) != alignment(*it) || in_group == match::kFeaturesPer8Bit) {
-      *it |= kLastOfGroup;
-      in_group = 0;
-    }
-  }
-}
-
 // Blocks of a band (refine_grid.glsl): from the band's first marked column on, at most
 // stride / 16 of them, as the stride is a multiple of 16.
 UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fine) {
@@ -169,11 +150,9 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
                                             static_cast<std::size_t>((range.columns + 16 * kCoarseSpan - 1) /
                                                                      (16 * kCoarseSpan)));
         const int T = layout.T;
-        const auto first = static_cast<std::ptrdiff_t>(offsets[l].size());
         for (const auto& f : level.features)
           offsets[l].push_back(static_cast<int32_t>(
               layout.offset(static_cast<int>(f.modality), f.bin, f.y % T, f.x % T, f.y / T, f.x / T)));
-        if (l + 1 == levels) groupByAlignment(offsets[l].begin() + first, offsets[l].end(), range.c_lo);
       }
       ++chunk.template_count;
       ++t;
