@@ -96,6 +96,7 @@ std::array<cv::Mat, 8> computeResponseMaps(const cv::Mat& spread);
 /// modality, per orientation bin and per (y mod T, x mod T) "grid" as 2D planes of cells
 /// (pixel / T), padded with zero cells on every side so that templates partly outside the
 /// image read zeros instead of wrapping around (OpenCV wraps, and loses the top/left border).
+/// Sizes and offsets count cells: a byte each in the CPU reference, a nibble each on the GPU.
 struct LinearMemoryLayout {
   int T = 0;
   int width = 0, height = 0;              ///< image size at this level, pixels
