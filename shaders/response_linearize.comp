@@ -7,7 +7,6 @@
 // lanes on llvmpipe, and far fewer of them pay.
 #include "common.glsl"
 const int CELLS = 8;
-const uint BITS = 4u;
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Spread { uint8_t spread[]; };
 layout(std430, binding = 1) writeonly buffer Memory { uint memory[]; };
@@ -31,17 +30,43 @@ void main() {
     int x = (cell + j - pc.pad) * pc.T + gx;
     s[j] = x >= 0 && x < pc.width ? uint(spread[y * pc.width + clamp(x, 0, pc.width - 1)]) : 0u;
   }
+  // All 8 bins' responses of a cell at once, a nibble per bin: a label at bin i gives bin b
+  // 4 - circular distance, as a thermometer code (v ones) so that the best over the cell's
+  // labels is an OR; the codes of bin i are those of bin 0 rotated by 4 i bits. Counting each
+  // nibble's ones turns the codes back into responses.
+  const uint CODES_OF_BIN_0 = 0x7310137Fu;  // bins 0..7: 4, 3, 2, 1, 0, 1, 2, 3
+  uint v[CELLS];
+  [[unroll]] for (int j = 0; j < CELLS; ++j) {
+    uint codes = 0u;
+    [[unroll]] for (int i = 0; i < 8; ++i) {
+      uint rotated = i == 0 ? CODES_OF_BIN_0 : (CODES_OF_BIN_0 << (4 * i)) | (CODES_OF_BIN_0 >> (32 - 4 * i));
+      codes |= ((s[j] >> uint(i)) & 1u) != 0u ? rotated : 0u;
+    }
+    v[j] = (codes & 0x11111111u) + ((codes >> 1u) & 0x11111111u) + ((codes >> 2u) & 0x11111111u) +
+           ((codes >> 3u) & 0x11111111u);
+  }
+  // v[j] holds cell j's bins; the memory wants, per bin, its 8 cells: transpose the 8 x 8
+  // nibbles in three rounds of swapping blocks (4 x 4, 2 x 2, then single nibbles).
+  [[unroll]] for (int j = 0; j < 4; ++j) {
+    uint a = v[j], c = v[j + 4];
+    v[j] = (a & 0x0000FFFFu) | (c << 16u);
+    v[j + 4] = (a >> 16u) | (c & 0xFFFF0000u);
+  }
+  [[unroll]] for (int j = 0; j < 8; ++j) {
+    if ((j & 2) != 0) continue;
+    uint a = v[j], c = v[j + 2];
+    v[j] = (a & 0x00FF00FFu) | ((c << 8u) & 0xFF00FF00u);
+    v[j + 2] = ((a >> 8u) & 0x00FF00FFu) | (c & 0xFF00FF00u);
+  }
+  [[unroll]] for (int j = 0; j < 8; j += 2) {
+    uint a = v[j], c = v[j + 1];
+    v[j] = (a & 0x0F0F0F0Fu) | ((c << 4u) & 0xF0F0F0F0u);
+    v[j + 1] = ((a >> 4u) & 0x0F0F0F0Fu) | (c & 0xF0F0F0F0u);
+  }
   uint plane = uint(pc.stride * pc.rows);
   uint word = uint((y / pc.T + pc.pad) * pc.stride + cell) / uint(CELLS);
-  for (int b = 0; b < 8; ++b) {
-    uint packed = 0u;
-    [[unroll]] for (int j = 0; j < CELLS; ++j) {
-      // Rotate the label set so that bin b is bit 0; bins d away are then bits d and 8 - d.
-      uint r = ((s[j] >> b) | (s[j] << (8 - b))) & 0xFFu;
-      uint best = (r & 1u) != 0u ? 4u : (r & 0x82u) != 0u ? 3u : (r & 0x44u) != 0u ? 2u : (r & 0x28u) != 0u ? 1u : 0u;
-      packed |= best << (BITS * uint(j));
-    }
+  [[unroll]] for (int b = 0; b < 8; ++b) {
     uint grid = uint(((pc.modality * 8 + b) * pc.T + y % pc.T) * pc.T + gx);
-    memory[grid * (plane / uint(CELLS)) + word] = packed;
+    memory[grid * (plane / uint(CELLS)) + word] = v[b];
   }
 }
