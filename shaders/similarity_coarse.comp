@@ -14,8 +14,7 @@ layout(push_constant) uniform Push {
 } pc;
 const int ROWS = 2;  // match kCoarseRows in similarity_gpu.cpp
 const int SPAN = 3;  // match kCoarseSpan in similarity_gpu.cpp
-// Texels holding 16 SPAN nibbles from any of the 32 nibble offsets of the first.
-const int TEXELS = (16 * SPAN + 30) / 32 + 1;
+const int TEXELS = TEXELS_FOR(16 * SPAN);
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
   int t = int(gl_WorkGroupID.y);
@@ -34,29 +33,15 @@ void main() {
   uvec4 lo[ROWS * SPAN], hi[ROWS * SPAN];
   for (int i = 0; i < ROWS * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
   while (f < end) {
-    int chunk_end = min(f + 63, end);
+    int chunk_end = min(f + FEATURES_PER_8BIT, end);
     uvec4 acc[ROWS * SPAN];
     for (int i = 0; i < ROWS * SPAN; ++i) acc[i] = uvec4(0u);
     for (; f < chunk_end; ++f) {
-      // Nibble offset of the first position for this feature (the stride is a multiple of
-      // 32, so every row has the same alignment): word q of the first texel, bit s of it.
-      uint off = uint(texelFetch(feature_offsets, f).x) + base;
-      uint q = (off >> 3u) & 3u, s = (off & 7u) * 4u;
-      int first = int(off >> 5u);
-      for (int r = 0; r < ROWS; ++r) {
-        uint words[4 * TEXELS];
-        for (int k = 0; k < TEXELS; ++k) {
-          uvec4 x = texelFetch(memory, first + r * row_texels + k);
-          words[4 * k] = x.x;
-          words[4 * k + 1] = x.y;
-          words[4 * k + 2] = x.z;
-          words[4 * k + 3] = x.w;
-        }
-        // The row's words from word q on, then each block's 64 bits from bit s.
-        uint v[2 * SPAN + 1];
-        for (int j = 0; j <= 2 * SPAN; ++j) v[j] = wordAt(words[j], words[j + 1], words[j + 2], words[j + 3], q);
-        for (int k = 0; k < SPAN; ++k) acc[r * SPAN + k] += nibbleBlock(v[2 * k], v[2 * k + 1], v[2 * k + 2], s);
-      }
+      // Nibble offset of the first position for this feature.
+      int first;
+      uint q, s;
+      nibbleAddress(uint(texelFetch(feature_offsets, f).x) + base, first, q, s);
+      for (int r = 0; r < ROWS; ++r) ADD_ROW_BLOCKS(acc, r * SPAN, first + r * row_texels, q, s)
     }
     for (int i = 0; i < ROWS * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
   }

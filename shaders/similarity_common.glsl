@@ -21,6 +21,40 @@ uvec4 nibbleBlock(uint a, uint b, uint c, uint s) {
   return uvec4(w & 0x0F0F0F0Fu, (w >> 4u) & 0x0F0F0F0Fu);
 }
 
+// Features whose byte sums add up before they widen (match::kFeaturesPer8Bit).
+const int FEATURES_PER_8BIT = 63;
+
+// Texels that hold `cells` consecutive cells starting at any of a texel's 32 nibbles.
+#define TEXELS_FOR(cells) (((cells) + 30) / 32 + 1)
+
+// Texel, word q in it and bit s in that word of nibble offset `off`. Strides are multiples
+// of 32 cells, so every row of a plane has the same q and s.
+void nibbleAddress(uint off, out int texel, out uint q, out uint s) {
+  texel = int(off >> 5u);
+  q = (off >> 3u) & 3u;
+  s = (off & 7u) * 4u;
+}
+
+// Adds SPAN blocks of 16 cells of one row, read from the TEXELS texels from `texel` on, to
+// acc[i0 .. i0 + SPAN - 1]: the row's words from word q on, each block's 64 bits from bit s.
+// SPAN and TEXELS (= TEXELS_FOR(16 * SPAN)) come from the kernel; a macro, because a
+// kernel's SPAN may be a specialization constant, which sizes no function parameter.
+#define ADD_ROW_BLOCKS(acc, i0, texel, q, s)                                                       \
+  {                                                                                                \
+    uint words_[4 * TEXELS];                                                                       \
+    for (int k_ = 0; k_ < TEXELS; ++k_) {                                                          \
+      uvec4 x_ = texelFetch(memory, (texel) + k_);                                                 \
+      words_[4 * k_] = x_.x;                                                                       \
+      words_[4 * k_ + 1] = x_.y;                                                                   \
+      words_[4 * k_ + 2] = x_.z;                                                                   \
+      words_[4 * k_ + 3] = x_.w;                                                                   \
+    }                                                                                              \
+    uint v_[2 * SPAN + 1];                                                                         \
+    for (int j_ = 0; j_ <= 2 * SPAN; ++j_)                                                         \
+      v_[j_] = wordAt(words_[j_], words_[j_ + 1], words_[j_ + 2], words_[j_ + 3], (q));            \
+    for (int k_ = 0; k_ < SPAN; ++k_) acc[(i0) + k_] += nibbleBlock(v_[2 * k_], v_[2 * k_ + 1], v_[2 * k_ + 2], (s)); \
+  }
+
 // Byte sums as nibbleBlock leaves them added into the packed 16-bit totals of
 // packed_scores.glsl (lo: cells 4j and 4j + 2 in word j, hi: 4j + 1 and 4j + 3).
 uint spreadBytes(uint v) { return (v & 0xFFu) | ((v & 0xFF00u) << 8u); }
