@@ -112,7 +112,7 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   // passes, so chunks are kept to 16384 templates for the split to have something to split.
   max_capacity_ = static_cast<uint32_t>(std::min<std::size_t>((dev.max_storage_buffer_range - 16) / 16, 1u << 30));
   capacity_ = std::min(capacity_, max_capacity_);
-  const std::size_t max_templates = std::min<std::size_t>(16384, chunk_templates_);
+  const std::size_t max_templates = chunk_templates_;
   std::size_t units_per_template = 0, binding_units = 0;
   if (levels > 1) {
     const auto& fl = layouts[0];

@@ -59,7 +59,7 @@ class Similarity {
   uint32_t max_capacity_ = 0;          // candidate slots one binding can hold
   bool full_ = false;                  // the last pass overflowed max_capacity_
   bool units_full_ = false;            // the last pass overflowed max_unit_capacity_
-  std::size_t chunk_templates_ = 16384;  // most templates of a chunk
+  std::size_t chunk_templates_ = 16384;  // most templates of a chunk: 16384 until splitChunks()
   uint32_t unit_capacity_ = 1u << 16;  // unit slots of one chunk
   uint32_t max_unit_capacity_ = 0;     // every unit of the largest chunk, or one binding's worth
   std::size_t template_bands_ = 0;     // template bands of the largest chunk
