@@ -28,6 +28,16 @@ bool columnGroup(int i, int width, int height, out int y0, out int x) {
   return i < (height + GROUP - 1) / GROUP * width;
 }
 
+// Colour pixels are packed BGRX words (byte 0 blue, 1 green, 2 red, 3 unused). Sums of them
+// under weights that total at most 256 fit 16-bit lanes, so the filters split a word into
+// its even bytes (blue, red) and odd bytes (green, unused) and sum all channels at once.
+uint evenLanes(uint bgrx) { return bgrx & 0x00FF00FFu; }
+uint oddLanes(uint bgrx) { return (bgrx >> 8u) & 0x00FF00FFu; }
+// Back to a packed word from lane sums, each shifted right by `shift`.
+uint fromLanes(uint even, uint odd, uint shift) {
+  return ((even >> shift) & 0x00FF00FFu) | (((odd >> shift) & 0x00FF00FFu) << 8u);
+}
+
 // BORDER_REPLICATE
 int clampIndex(int i, int n) { return clamp(i, 0, n - 1); }
 

@@ -1,22 +1,27 @@
 #version 450
 // Vertical pass of the 7x7 binomial blur, rounding back to 8 bits as OpenCV does; GROUP
-// neighbouring rows of one channel column per invocation (common.glsl).
+// neighbouring rows of one pixel column per invocation (common.glsl). In: the row pass's
+// 16-bit lanes; out: packed BGRX words.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint16_t src[]; };
-layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
+layout(std430, binding = 0) readonly buffer Src { uvec2 src[]; };
+layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
 void main() {
   int i = LINEAR_INVOCATION;
-  int row = pc.width * 3;
-  int y0, xc;
-  if (!columnGroup(i, row, pc.height, y0, xc)) return;
-  uint v[GROUP + 6];
-  [[unroll]] for (int t = 0; t < GROUP + 6; ++t) v[t] = uint(src[clampIndex(y0 + t - 3, pc.height) * row + xc]);
+  int y0, x;
+  if (!columnGroup(i, pc.width, pc.height, y0, x)) return;
+  // Column sums reach 256 x 65280: 24 bits, so one channel per word here.
+  uvec3 v[GROUP + 6];
+  [[unroll]] for (int t = 0; t < GROUP + 6; ++t) {
+    uvec2 s = src[clampIndex(y0 + t - 3, pc.height) * pc.width + x];
+    v[t] = uvec3(s.x & 0xFFFFu, s.y & 0xFFFFu, s.x >> 16u);
+  }
   [[unroll]] for (int j = 0; j < GROUP; ++j) {
-    uint acc = 0u;
+    uvec3 acc = uvec3(0u);
     [[unroll]] for (int t = 0; t < 7; ++t) acc += k[t] * v[j + t];
-    if (y0 + j < pc.height) dst[(y0 + j) * row + xc] = uint8_t((acc + 32768u) >> 16);
+    uvec3 c = (acc + 32768u) >> 16u;
+    if (y0 + j < pc.height) dst[(y0 + j) * pc.width + x] = c.x | (c.y << 8u) | (c.z << 16u);
   }
 }

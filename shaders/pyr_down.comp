@@ -1,34 +1,41 @@
 #version 450
 // Next pyramid level of the colour image: 5x5 binomial, every second pixel, reflected border.
+// Pixels are packed BGRX words (common.glsl).
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint8_t src[]; };
-layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
+layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int src_width; int src_height; int width; int height; } pc;
-const int k[5] = int[](1, 4, 6, 4, 1);
+const uint k[5] = uint[](1u, 4u, 6u, 4u, 1u);
 void main() {
   int i = LINEAR_INVOCATION;
   int y, x0;
   if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   // GROUP neighbouring output pixels of a row (common.glsl) share the 2 GROUP + 3 source
-  // columns of their windows.
+  // columns of their windows. The weights sum to 256, so each sum of channel bytes fits the
+  // 16-bit lanes of evenLanes / oddLanes: all channels at once, carry-free.
   int cols[2 * GROUP + 3];
   [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) cols[t] = reflect101Index(2 * x0 + t - 2, pc.src_width);
-  int rows[5];
-  [[unroll]] for (int r = 0; r < 5; ++r) rows[r] = reflect101Index(2 * y + r - 2, pc.src_height) * pc.src_width;
-  [[unroll]] for (int ch = 0; ch < 3; ++ch) {
-    int acc[GROUP];
-    [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0;
-    [[unroll]] for (int r = 0; r < 5; ++r) {
-      int v[2 * GROUP + 3];
-      [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) v[t] = int(src[(rows[r] + cols[t]) * 3 + ch]);
-      [[unroll]] for (int j = 0; j < GROUP; ++j) {
-        int racc = 0;
-        [[unroll]] for (int t = 0; t < 5; ++t) racc += k[t] * v[2 * j + t];
-        acc[j] += k[r] * racc;
-      }
+  uint even[GROUP], odd[GROUP];
+  [[unroll]] for (int j = 0; j < GROUP; ++j) even[j] = odd[j] = 0u;
+  [[unroll]] for (int r = 0; r < 5; ++r) {
+    int row = reflect101Index(2 * y + r - 2, pc.src_height) * pc.src_width;
+    uint e[2 * GROUP + 3], o[2 * GROUP + 3];
+    [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) {
+      uint v = src[row + cols[t]];
+      e[t] = evenLanes(v);
+      o[t] = oddLanes(v);
     }
-    [[unroll]] for (int j = 0; j < GROUP; ++j)
-      if (x0 + j < pc.width) dst[(y * pc.width + x0 + j) * 3 + ch] = uint8_t((acc[j] + 128) >> 8);
+    [[unroll]] for (int j = 0; j < GROUP; ++j) {
+      uint re = 0u, ro = 0u;
+      [[unroll]] for (int t = 0; t < 5; ++t) {
+        re += k[t] * e[2 * j + t];
+        ro += k[t] * o[2 * j + t];
+      }
+      even[j] += k[r] * re;
+      odd[j] += k[r] * ro;
+    }
   }
+  [[unroll]] for (int j = 0; j < GROUP; ++j)
+    if (x0 + j < pc.width) dst[y * pc.width + x0 + j] = fromLanes(even[j] + 0x00800080u, odd[j] + 0x00800080u, 8u);
 }

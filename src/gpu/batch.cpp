@@ -63,12 +63,17 @@ std::size_t Batch::staging(std::size_t bytes) {
 
 void Batch::upload(const Buffer& dst, const void* data, std::size_t bytes, std::size_t offset) {
   if (bytes == 0) return;
+  std::memcpy(uploadInPlace(dst, bytes, offset), data, bytes);
+}
+
+void* Batch::uploadInPlace(const Buffer& dst, std::size_t bytes, std::size_t offset) {
+  if (bytes == 0) return nullptr;
   if (offset + bytes > dst.size()) throw std::out_of_range("gpu::Batch::upload past the end of a buffer");
   begin();
   Buffer& s = staging_[staging(bytes)];
-  std::memcpy(s.mapped(), data, bytes);
   cmd_.copyBuffer(s.handle(), dst.handle(), vk::BufferCopy{.srcOffset = 0, .dstOffset = offset, .size = bytes});
   barrier();
+  return s.mapped();
 }
 
 void Batch::fill(const Buffer& dst, uint32_t value, std::size_t bytes, std::size_t offset) {

@@ -23,6 +23,9 @@ class Batch {
 
   /// Copies `bytes` from host memory (copied now, so `data` may go away) into `dst` at `offset`.
   void upload(const Buffer& dst, const void* data, std::size_t bytes, std::size_t offset = 0);
+  /// Like upload(), but returns the staging memory for the caller to fill (before submit()):
+  /// data that needs converting anyway is written there once instead of copied twice.
+  void* uploadInPlace(const Buffer& dst, std::size_t bytes, std::size_t offset = 0);
   /// Fills `bytes` of `dst` at `offset` with the 32-bit word `value`.
   void fill(const Buffer& dst, uint32_t value, std::size_t bytes = VK_WHOLE_SIZE, std::size_t offset = 0);
   /// Records a dispatch of `groups` workgroups with the given buffers and push constants.

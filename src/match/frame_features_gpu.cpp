@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "match/match_geometry.hpp"
 #include "vkpose/error.hpp"
@@ -80,23 +81,25 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
 
     if (params_.use_colour) {
-      L.bgr.reserve(ctx_, n * 3);
+      // Colour pixels are packed BGRX words on the device (shaders/common.glsl): a word load
+      // per pixel instead of a byte load per channel, each being a loop over the lanes on
+      // llvmpipe. The frame is converted straight into the staging memory.
+      L.bgr.reserve(ctx_, n * 4);
       if (l == 0) {
-        cv::Mat bgr = frame.bgr.isContinuous() ? frame.bgr : frame.bgr.clone();
-        batch.upload(L.bgr, bgr.data, n * 3);
+        cv::Mat bgrx(L.size, CV_8UC4, batch.uploadInPlace(L.bgr, n * 4));
+        cv::cvtColor(frame.bgr, bgrx, cv::COLOR_BGR2BGRA);
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
         batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, row_groups);
       }
-      L.blur_rows.reserve(ctx_, n * 3 * 2);
-      L.smoothed.reserve(ctx_, n * 3);
+      L.blur_rows.reserve(ctx_, n * 8);
+      L.smoothed.reserve(ctx_, n * 4);
       L.raw_bins.reserve(ctx_, n);
       L.magnitude.reserve(ctx_, n * 4);
       L.labels[0].reserve(ctx_, n);
       batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
-      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp,
-                           groupsFor(3 * w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup));
+      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, column_groups);
       batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, row_groups);
       struct {
         int32_t width, height;
