@@ -38,6 +38,34 @@ uint fromLanes(uint even, uint odd, uint shift) {
   return ((even >> shift) & 0x00FF00FFu) | (((odd >> shift) & 0x00FF00FFu) << 8u);
 }
 
+// Label images (orientation bins, labels, spread labels) are packed 4 pixels per word, rows
+// of wordsPerRow(width) words, byte x % 4 of word x / 4 holding pixel x; the bytes past the
+// width are 0. Kernels on them take a word (4 neighbouring pixels) per invocation: one load
+// instead of four, each load being a loop over the lanes on llvmpipe.
+int wordsPerRow(int width) { return (width + 3) / 4; }
+
+// Invocation i's word of a label image: row y, first pixel x0 (a multiple of 4). False past
+// the last word.
+bool rowWord(int i, int width, int height, out int y, out int x0) {
+  int per_row = wordsPerRow(width);
+  y = i / per_row;
+  x0 = (i - y * per_row) * 4;
+  return i < per_row * height;
+}
+
+uint byteOf(uint word, int b) { return (word >> (8u * uint(b))) & 0xFFu; }
+
+// The bytes of the word at x0 that lie inside a row of `width` pixels.
+uint insideBytes(int x0, int width) { return width - x0 >= 4 ? 0xFFFFFFFFu : (1u << (8u * uint(width - x0))) - 1u; }
+
+// Pixel clamp(x, 0, width - 1) of a packed row, given its words at pixels x0 - 4, x0 and
+// x0 + 4 (x0 a multiple of 4; x within x0 - 4 .. x0 + 7): BORDER_REPLICATE for windows
+// of radius up to 4 around the word at x0.
+uint clampedByte(uint left, uint centre, uint right, int x, int x0, int width) {
+  int t = clamp(x, 0, width - 1) - x0;
+  return byteOf(t < 0 ? left : t < 4 ? centre : right, t & 3);
+}
+
 // BORDER_REPLICATE
 int clampIndex(int i, int n) { return clamp(i, 0, n - 1); }
 

@@ -1,16 +1,15 @@
 #version 450
 // LINEMOD's least-squares depth normals: 8 neighbours 5 px away, those differing from the
 // centre by difference_threshold or more left out; binned into 8 image-plane directions.
+// Out: a packed label image (common.glsl), a word of 4 pixels per invocation.
 #include "common.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Depth { uint16_t depth[]; };
-layout(std430, binding = 1) writeonly buffer Labels { uint8_t labels[]; };
+layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
 layout(push_constant) uniform Push { int width; int height; int distance_threshold; int difference_threshold; } pc;
 const int R = 5;
-void main() {
-  int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
+uint normalLabel(int x, int y) {
+  int i = y * pc.width + x;
   uint label = 0u;
   int d = int(depth[i]);
   if (y >= R && y < pc.height - R - 1 && x >= R && x < pc.width - R - 1 && d < pc.distance_threshold) {
@@ -31,5 +30,14 @@ void main() {
     int ddy = -a1 * b0 + a0 * b1;
     if (!(ddx == 0 && ddy == 0 && det * d == 0)) label = 1u << normalOrientationBin(ddx, ddy);
   }
-  labels[i] = uint8_t(label);
+  return label;
+}
+
+void main() {
+  int y, x0;
+  if (!rowWord(LINEAR_INVOCATION, pc.width, pc.height, y, x0)) return;
+  uint word = 0u;
+  for (int j = 0; j < 4; ++j)
+    if (x0 + j < pc.width) word |= normalLabel(x0 + j, y) << (8u * uint(j));
+  labels[y * wordsPerRow(pc.width) + x0 / 4] = word;
 }

@@ -1,13 +1,18 @@
 #version 450
-// Nearest-neighbour halving of a label image: pixel (2x, 2y).
+// Nearest-neighbour halving of a label image: pixel (2x, 2y). In and out: packed label
+// images (common.glsl); a source word holds 2 of the 4 pixels of an output word.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint8_t src[]; };
-layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
+layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int src_width; int width; int height; } pc;
 void main() {
-  int i = LINEAR_INVOCATION;
-  if (i >= pc.width * pc.height) return;
-  int y = i / pc.width, x = i - y * pc.width;
-  dst[i] = src[2 * y * pc.src_width + 2 * x];
+  int y, x0;
+  if (!rowWord(LINEAR_INVOCATION, pc.width, pc.height, y, x0)) return;
+  int src_per_row = wordsPerRow(pc.src_width);
+  int row = 2 * y * src_per_row, xw = x0 / 2;
+  uint a = src[row + xw], b = src[row + min(xw + 1, src_per_row - 1)];
+  // Bytes 0 and 2 of each.
+  uint word = (a & 0xFFu) | ((a >> 8u) & 0xFF00u) | ((b & 0xFFu) << 16u) | ((b << 8u) & 0xFF000000u);
+  dst[y * wordsPerRow(pc.width) + x0 / 4] = word & insideBytes(x0, pc.width);
 }

@@ -1,29 +1,34 @@
 #version 450
 // Keeps a pixel's orientation where its magnitude passes the weak threshold and at least 5
-// of its 3x3 neighbourhood agree (first bin wins ties). Output: 1 << bin, or 0.
+// of its 3x3 neighbourhood agree (first bin wins ties). In: sobel_orientation's packed
+// bin | 8 if strong. Out: a packed label image (common.glsl) of 1 << bin, or 0.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Bins { uint8_t bins[]; };
-layout(std430, binding = 1) readonly buffer Mag { int magnitude[]; };
-layout(std430, binding = 2) writeonly buffer Labels { uint8_t labels[]; };
-layout(push_constant) uniform Push { int width; int height; float threshold_sq; } pc;
+layout(std430, binding = 0) readonly buffer Bins { uint bins[]; };
+layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
+layout(push_constant) uniform Push { int width; int height; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
   int y, x0;
-  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
+  if (!rowWord(i, pc.width, pc.height, y, x0)) return;
   // The 3x3 histograms of bins as 4-bit counts in one word each (at most 9 per bin): no
-  // per-lane array indexing, which is a loop over the lanes on llvmpipe. GROUP neighbouring
-  // pixels of a row (common.glsl) share the 3 x (GROUP + 2) loads.
-  uint histogram[GROUP];
-  [[unroll]] for (int j = 0; j < GROUP; ++j) histogram[j] = 0u;
+  // per-lane array indexing, which is a loop over the lanes on llvmpipe. The 4 pixels of a
+  // word share the 3 x 3 word loads.
+  int per_row = wordsPerRow(pc.width), xw = x0 / 4;
+  uint histogram[4];
+  [[unroll]] for (int j = 0; j < 4; ++j) histogram[j] = 0u;
+  uint centre_word = 0u;
   [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
-    int row = clampIndex(y + dy, pc.height) * pc.width;
-    [[unroll]] for (int t = 0; t < GROUP + 2; ++t) {
-      uint one = 1u << (4u * uint(bins[row + clampIndex(x0 + t - 1, pc.width)]));
-      [[unroll]] for (int j = 0; j < GROUP; ++j) histogram[j] += t >= j && t <= j + 2 ? one : 0u;
+    int row = clampIndex(y + dy, pc.height) * per_row;
+    uint left = bins[row + max(xw - 1, 0)], centre = bins[row + xw], right = bins[row + min(xw + 1, per_row - 1)];
+    if (dy == 0) centre_word = centre;
+    [[unroll]] for (int t = 0; t < 6; ++t) {
+      uint one = 1u << (4u * (clampedByte(left, centre, right, x0 + t - 1, x0, pc.width) & 7u));
+      [[unroll]] for (int j = 0; j < 4; ++j) histogram[j] += t >= j && t <= j + 2 ? one : 0u;
     }
   }
-  [[unroll]] for (int j = 0; j < GROUP; ++j) {
+  uint word = 0u;
+  [[unroll]] for (int j = 0; j < 4; ++j) {
     int x = x0 + j;
     uint best = 0u, best_count = histogram[j] & 15u;
     [[unroll]] for (uint b = 1u; b < 8u; ++b) {
@@ -33,9 +38,8 @@ void main() {
     }
     // Pixels on the border keep no label, so the clamped neighbours above never count.
     bool inside = x > 0 && y > 0 && x < pc.width - 1 && y < pc.height - 1;
-    if (x < pc.width) {
-      bool strong = float(magnitude[y * pc.width + x]) > pc.threshold_sq;
-      labels[y * pc.width + x] = uint8_t(inside && strong && best_count >= 5u ? 1u << best : 0u);
-    }
+    bool strong = (byteOf(centre_word, j) & 8u) != 0u;
+    word |= (inside && strong && best_count >= 5u ? 1u << best : 0u) << (8u * uint(j));
   }
+  labels[y * per_row + xw] = word;
 }

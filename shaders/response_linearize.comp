@@ -8,7 +8,7 @@
 #include "common.glsl"
 const int CELLS = 8;
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Spread { uint8_t spread[]; };
+layout(std430, binding = 0) readonly buffer Spread { uint spread[]; };  // packed (common.glsl)
 layout(std430, binding = 1) writeonly buffer Memory { uint memory[]; };
 layout(push_constant) uniform Push {
   int width; int height; int T; int pad; int stride; int rows; int modality;
@@ -28,7 +28,8 @@ void main() {
   uint s[CELLS];
   [[unroll]] for (int j = 0; j < CELLS; ++j) {
     int x = (cell + j - pc.pad) * pc.T + gx;
-    s[j] = x >= 0 && x < pc.width ? uint(spread[y * pc.width + clamp(x, 0, pc.width - 1)]) : 0u;
+    int xc = clamp(x, 0, pc.width - 1);
+    s[j] = x >= 0 && x < pc.width ? byteOf(spread[y * wordsPerRow(pc.width) + xc / 4], xc & 3) : 0u;
   }
   // All 8 bins' responses of a cell at once, a nibble per bin: a label at bin i gives bin b
   // 4 - circular distance, as a thermometer code (v ones) so that the best over the cell's

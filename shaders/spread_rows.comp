@@ -1,22 +1,26 @@
 #version 450
 // First half of LINEMOD spreading: OR of the labels in the T pixels at and right of each
-// pixel. spread.comp then ORs T of these downwards: T + T loads instead of T * T. GROUP
-// neighbouring pixels of a row per invocation (common.glsl): T + GROUP - 1 loads for them.
+// pixel (none past the width). spread.comp then ORs T of these downwards: T + T loads
+// instead of T * T. In and out: packed label images (common.glsl); a word of 4 pixels per
+// invocation, whose windows span T + 3 pixels: T / 4 + 2 word loads at most.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint8_t src[]; };
-layout(std430, binding = 1) writeonly buffer Dst { uint8_t dst[]; };
+layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
-  int i = LINEAR_INVOCATION;
   int y, x0;
-  if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
-  uint acc[GROUP];
-  [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0u;
-  for (int t = 0; t < pc.T + GROUP - 1; ++t) {
-    uint label = x0 + t < pc.width ? uint(src[y * pc.width + min(x0 + t, pc.width - 1)]) : 0u;
-    [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] |= t >= j && t < j + pc.T ? label : 0u;
+  if (!rowWord(LINEAR_INVOCATION, pc.width, pc.height, y, x0)) return;
+  int per_row = wordsPerRow(pc.width), xw = x0 / 4, row = y * per_row;
+  // The word of pixels x0 + s .. x0 + s + 3 is word q = s / 4 after x0 shifted down by
+  // s % 4 bytes, the next word's low bytes filling in; the bytes past the width are 0, as are
+  // the words past the row.
+  uint acc = 0u, current = src[row + xw];
+  for (int q = 0; 4 * q < pc.T; ++q) {
+    uint next = xw + q + 1 < per_row ? src[row + xw + q + 1] : 0u;
+    [[unroll]] for (int r = 0; r < 4; ++r)
+      if (4 * q + r < pc.T) acc |= r == 0 ? current : (current >> (8u * uint(r))) | (next << (32u - 8u * uint(r)));
+    current = next;
   }
-  [[unroll]] for (int j = 0; j < GROUP; ++j)
-    if (x0 + j < pc.width) dst[y * pc.width + x0 + j] = uint8_t(acc[j]);
+  dst[row + xw] = acc;
 }

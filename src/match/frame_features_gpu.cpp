@@ -31,8 +31,8 @@ struct FrameFeatures::Kernels {
   explicit Kernels(const GpuContext& c)
       : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush)),
         blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush)),
-        sobel(c, ShaderId::sobel_orientation, 3, sizeof(SizePush)),
-        vote(c, ShaderId::orientation_vote, 3, 12),
+        sobel(c, ShaderId::sobel_orientation, 2, 12),
+        vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush)),
         pyr_down(c, ShaderId::pyr_down, 2, 16),
         normals(c, ShaderId::depth_normals, 2, 16),
         median(c, ShaderId::median5, 2, sizeof(SizePush)),
@@ -73,12 +73,17 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     L.size = sizes[l];
     const std::size_t n = static_cast<std::size_t>(L.size.area());
     const SizePush sp{L.size.width, L.size.height};
-    const uint32_t groups = groupsFor(n, kGroup);
     // Sliding-window kernels take kPixelGroup neighbouring pixels of a row, or of a column,
     // per invocation (GROUP in shaders/common.glsl).
     const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
     const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kGroup);
     const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
+    // Label images are packed 4 pixels per word, rows padded to whole words (wordsPerRow in
+    // shaders/common.glsl); their kernels take a word per invocation, spread a column of
+    // kPixelGroup words.
+    const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
+    const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
+    const uint32_t word_column_groups = groupsFor(words_per_row * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
 
     if (params_.use_colour) {
       // Colour pixels are packed BGRX words on the device (shaders/common.glsl): a word load
@@ -95,33 +100,32 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       }
       L.blur_rows.reserve(ctx_, n * 8);
       L.smoothed.reserve(ctx_, n * 4);
-      L.raw_bins.reserve(ctx_, n);
-      L.magnitude.reserve(ctx_, n * 4);
-      L.labels[0].reserve(ctx_, n);
+      L.raw_bins.reserve(ctx_, label_bytes);
+      L.labels[0].reserve(ctx_, label_bytes);
       batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
       batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, column_groups);
-      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sp, row_groups);
       struct {
         int32_t width, height;
         float threshold_sq;
-      } vp{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
-      batch.dispatchLinear(k.vote, {L.raw_bins, L.magnitude, L.labels[0]}, vp, row_groups);
+      } sobel_push{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
+      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins}, sobel_push, word_groups);
+      batch.dispatchLinear(k.vote, {L.raw_bins, L.labels[0]}, sp, word_groups);
     }
     if (params_.use_depth) {
-      L.labels[1].reserve(ctx_, n);
+      L.labels[1].reserve(ctx_, label_bytes);
       if (l == 0) {
         depth_.reserve(ctx_, n * 2);
-        L.depth_raw.reserve(ctx_, n);
+        L.depth_raw.reserve(ctx_, label_bytes);
         cv::Mat depth = frame.depth_mm.isContinuous() ? frame.depth_mm : frame.depth_mm.clone();
         batch.upload(depth_, depth.data, n * 2);
         const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
                                  params_.difference_threshold_mm};
-        batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, groups);
-        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, row_groups);
+        batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, word_groups);
+        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, word_groups);
       } else {
         const Level& P = levels_[l - 1];
         const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
-        batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, groups);
+        batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, word_groups);
       }
     }
 
@@ -136,13 +140,13 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.fill(L.memory, 0u);
       L.layout = layout;
     }
-    L.spread.reserve(ctx_, n);
-    L.spread_rows.reserve(ctx_, n);
+    L.spread.reserve(ctx_, label_bytes);
+    L.spread_rows.reserve(ctx_, label_bytes);
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
       const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
-      batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, row_groups);
-      batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, column_groups);
+      batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, word_groups);
+      batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, word_column_groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
       // One invocation per word (8 padded cells) of a pixel row and grid column
       // (response_linearize.comp).
@@ -161,8 +165,12 @@ void FrameFeatures::downloadLabels(Batch& batch, std::vector<QuantizedLevel>& ou
     out[l].T = params_.T[l];
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
-      out[l].labels[m].create(levels_[l].size, CV_8UC1);
-      batch.download(levels_[l].labels[m], out[l].labels[m].data, static_cast<std::size_t>(levels_[l].size.area()));
+      // Packed rows of whole words: a view of the padded image, cropped to the width.
+      const cv::Size size = levels_[l].size;
+      const int pitch = (size.width + 3) / 4 * 4;
+      cv::Mat padded(size.height, pitch, CV_8UC1);
+      batch.download(levels_[l].labels[m], padded.data, padded.total());
+      out[l].labels[m] = padded.colRange(0, size.width);
     }
   }
 }

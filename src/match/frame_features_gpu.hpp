@@ -31,7 +31,7 @@ class FrameFeatures {
  private:
   struct Level {
     cv::Size size;
-    Buffer bgr, blur_rows, smoothed, raw_bins, magnitude, depth_raw;
+    Buffer bgr, blur_rows, smoothed, raw_bins, depth_raw;
     Buffer labels[kModalityCount];
     Buffer spread_rows, spread;
     Buffer memory;
