@@ -4,7 +4,7 @@
 // 16-bit lanes; out: packed BGRX words.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uvec2 src[]; };
+layout(binding = 0) uniform utextureBuffer src;  // R32G32 texels: a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
@@ -15,7 +15,7 @@ void main() {
   // Column sums reach 256 x 65280: 24 bits, so one channel per word here.
   uvec3 v[GROUP + 6];
   [[unroll]] for (int t = 0; t < GROUP + 6; ++t) {
-    uvec2 s = src[clampIndex(y0 + t - 3, pc.height) * pc.width + x];
+    uvec2 s = texelFetch(src, clampIndex(y0 + t - 3, pc.height) * pc.width + x).xy;
     v[t] = uvec3(s.x & 0xFFFFu, s.y & 0xFFFFu, s.x >> 16u);
   }
   [[unroll]] for (int j = 0; j < GROUP; ++j) {

@@ -30,7 +30,7 @@ struct SizePush {
 struct FrameFeatures::Kernels {
   explicit Kernels(const GpuContext& c)
       : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush)),
-        blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush)),
+        blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush), {}, {{0, vk::Format::eR32G32Uint}}),
         sobel(c, ShaderId::sobel_orientation, 2, 12),
         vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush)),
         pyr_down(c, ShaderId::pyr_down, 2, 16),
@@ -39,7 +39,7 @@ struct FrameFeatures::Kernels {
         downsample(c, ShaderId::downsample_labels, 2, 12),
         spread_rows(c, ShaderId::spread_rows, 2, 12),
         spread(c, ShaderId::spread, 2, 12),
-        linearize(c, ShaderId::response_linearize, 2, 28) {}
+        linearize(c, ShaderId::response_linearize, 2, 28, {}, {{0, vk::Format::eR32Uint}}) {}
   Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
@@ -148,10 +148,10 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, word_groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, word_column_groups);
       const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
-      // One invocation per word (8 padded cells) of a pixel row and grid column
+      // One invocation per 16 aligned padded cells of a pixel row and grid column
       // (response_linearize.comp).
       const int cells_x = (L.size.width + layout.T - 1) / layout.T;
-      const auto words = static_cast<std::size_t>((layout.pad + cells_x + 7) / 8 - layout.pad / 8);
+      const auto words = static_cast<std::size_t>((layout.pad + cells_x + 15) / 16 - layout.pad / 16);
       batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
                            groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * words,
                                      kGroup));
