@@ -4,20 +4,20 @@
 // Out: a packed label image (common.glsl), a word of 4 pixels per invocation.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Depth { uint16_t depth[]; };
+layout(binding = 0) uniform utextureBuffer depth;  // r16ui; a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
 layout(push_constant) uniform Push { int width; int height; int distance_threshold; int difference_threshold; } pc;
 const int R = 5;
 uint normalLabel(int x, int y) {
   int i = y * pc.width + x;
   uint label = 0u;
-  int d = int(depth[i]);
+  int d = int(texelFetch(depth, i).x);
   if (y >= R && y < pc.height - R - 1 && x >= R && x < pc.width - R - 1 && d < pc.distance_threshold) {
     int a0 = 0, a1 = 0, a3 = 0, b0 = 0, b1 = 0;
     for (int j = -R; j <= R; j += R)
       for (int k = -R; k <= R; k += R) {
         if (k == 0 && j == 0) continue;
-        int delta = int(depth[i + j * pc.width + k]) - d;
+        int delta = int(texelFetch(depth, i + j * pc.width + k).x) - d;
         if (abs(delta) >= pc.difference_threshold) continue;
         a0 += k * k;
         a1 += k * j;

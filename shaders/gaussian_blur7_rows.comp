@@ -5,7 +5,7 @@
 // summed at once in the 16-bit lanes of a word, carry-free.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uvec2 dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 const uint k[7] = uint[](8u, 28u, 56u, 72u, 56u, 28u, 8u);
@@ -15,7 +15,7 @@ void main() {
   if (!rowGroup(i, pc.width, pc.height, y, x0)) return;
   uint e[GROUP + 6], o[GROUP + 6];
   [[unroll]] for (int t = 0; t < GROUP + 6; ++t) {
-    uint v = src[y * pc.width + clampIndex(x0 + t - 3, pc.width)];
+    uint v = texelFetch(src, y * pc.width + clampIndex(x0 + t - 3, pc.width)).x;
     e[t] = evenLanes(v);
     o[t] = oddLanes(v);
   }

@@ -3,7 +3,7 @@
 // out: packed label images (common.glsl).
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 // The 4 low bits of v, one per byte.
@@ -22,7 +22,8 @@ void main() {
   [[unroll]] for (int j = 0; j < 4; ++j) low[j] = high[j] = 0u;
   [[unroll]] for (int dy = -2; dy <= 2; ++dy) {
     int row = clampIndex(y + dy, pc.height) * per_row;
-    uint left = src[row + max(xw - 1, 0)], centre = src[row + xw], right = src[row + min(xw + 1, per_row - 1)];
+    uint left = texelFetch(src, row + max(xw - 1, 0)).x, centre = texelFetch(src, row + xw).x,
+         right = texelFetch(src, row + min(xw + 1, per_row - 1)).x;
     [[unroll]] for (int t = 0; t < 8; ++t) {
       uint v = clampedByte(left, centre, right, x0 + t - 2, x0, pc.width);
       uint l = bitsToBytes(v & 15u), h = bitsToBytes(v >> 4);

@@ -4,7 +4,7 @@
 // bin | 8 if strong. Out: a packed label image (common.glsl) of 1 << bin, or 0.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Bins { uint bins[]; };
+layout(binding = 0) uniform utextureBuffer bins;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
 layout(push_constant) uniform Push { int width; int height; } pc;
 void main() {
@@ -20,7 +20,8 @@ void main() {
   uint centre_word = 0u;
   [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
     int row = clampIndex(y + dy, pc.height) * per_row;
-    uint left = bins[row + max(xw - 1, 0)], centre = bins[row + xw], right = bins[row + min(xw + 1, per_row - 1)];
+    uint left = texelFetch(bins, row + max(xw - 1, 0)).x, centre = texelFetch(bins, row + xw).x,
+         right = texelFetch(bins, row + min(xw + 1, per_row - 1)).x;
     if (dy == 0) centre_word = centre;
     [[unroll]] for (int t = 0; t < 6; ++t) {
       uint one = 1u << (4u * (clampedByte(left, centre, right, x0 + t - 1, x0, pc.width) & 7u));

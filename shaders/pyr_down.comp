@@ -3,7 +3,7 @@
 // Pixels are packed BGRX words (common.glsl).
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int src_width; int src_height; int width; int height; } pc;
 const uint k[5] = uint[](1u, 4u, 6u, 4u, 1u);
@@ -22,7 +22,7 @@ void main() {
     int row = reflect101Index(2 * y + r - 2, pc.src_height) * pc.src_width;
     uint e[2 * GROUP + 3], o[2 * GROUP + 3];
     [[unroll]] for (int t = 0; t < 2 * GROUP + 3; ++t) {
-      uint v = src[row + cols[t]];
+      uint v = texelFetch(src, row + cols[t]).x;
       e[t] = evenLanes(v);
       o[t] = oddLanes(v);
     }

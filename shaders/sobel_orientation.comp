@@ -5,7 +5,7 @@
 // of bin | 8 if strong.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint img[]; };
+layout(binding = 0) uniform utextureBuffer img;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Bins { uint bins[]; };
 layout(push_constant) uniform Push { int width; int height; float threshold_sq; } pc;
 void main() {
@@ -21,7 +21,7 @@ void main() {
   }
   uint w[3][6];
   [[unroll]] for (int r = 0; r < 3; ++r)
-    [[unroll]] for (int t = 0; t < 6; ++t) w[r][t] = img[rows[r] + clampIndex(x0 + t - 1, pc.width)];
+    [[unroll]] for (int t = 0; t < 6; ++t) w[r][t] = texelFetch(img, rows[r] + clampIndex(x0 + t - 1, pc.width)).x;
   [[unroll]] for (int ch = 0; ch < 3; ++ch) {
     int v[3][6];
     [[unroll]] for (int r = 0; r < 3; ++r)

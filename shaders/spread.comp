@@ -5,7 +5,7 @@
 // T + GROUP - 1 word loads for 4 GROUP pixels.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint rows[]; };
+layout(binding = 0) uniform utextureBuffer rows;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
@@ -16,7 +16,7 @@ void main() {
   uint acc[GROUP];
   [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] = 0u;
   for (int t = 0; t < pc.T + GROUP - 1; ++t) {
-    uint labels = y0 + t < pc.height ? rows[min(y0 + t, pc.height - 1) * per_row + xw] : 0u;
+    uint labels = y0 + t < pc.height ? texelFetch(rows, min(y0 + t, pc.height - 1) * per_row + xw).x : 0u;
     [[unroll]] for (int j = 0; j < GROUP; ++j) acc[j] |= t >= j && t < j + pc.T ? labels : 0u;
   }
   [[unroll]] for (int j = 0; j < GROUP; ++j)

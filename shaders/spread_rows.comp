@@ -5,7 +5,7 @@
 // invocation, whose windows span T + 3 pixels: T / 4 + 2 word loads at most.
 #include "common.glsl"
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Src { uint src[]; };
+layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
 layout(push_constant) uniform Push { int width; int height; int T; } pc;
 void main() {
@@ -15,9 +15,9 @@ void main() {
   // The word of pixels x0 + s .. x0 + s + 3 is word q = s / 4 after x0 shifted down by
   // s % 4 bytes, the next word's low bytes filling in; the bytes past the width are 0, as are
   // the words past the row.
-  uint acc = 0u, current = src[row + xw];
+  uint acc = 0u, current = texelFetch(src, row + xw).x;
   for (int q = 0; 4 * q < pc.T; ++q) {
-    uint next = xw + q + 1 < per_row ? src[row + xw + q + 1] : 0u;
+    uint next = xw + q + 1 < per_row ? texelFetch(src, row + xw + q + 1).x : 0u;
     [[unroll]] for (int r = 0; r < 4; ++r)
       if (4 * q + r < pc.T) acc |= r == 0 ? current : (current >> (8u * uint(r))) | (next << (32u - 8u * uint(r)));
     current = next;

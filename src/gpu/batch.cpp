@@ -14,6 +14,7 @@ constexpr uint32_t kMaxBindings = 16;
 
 std::size_t texelBytes(vk::Format format) {
   switch (format) {
+    case vk::Format::eR16Uint: return 2;
     case vk::Format::eR32Uint:
     case vk::Format::eR32Sint: return 4;
     case vk::Format::eR32G32Uint: return 8;

@@ -28,18 +28,22 @@ struct SizePush {
 }  // namespace
 
 struct FrameFeatures::Kernels {
+  // Every kernel reads its input (binding 0) through texel fetches, gathers on llvmpipe,
+  // where a storage-buffer load at a per-invocation offset is a loop over the lanes: packed
+  // words (colour pixels, label images), the row blur's 16-bit sums, 16-bit depth.
+  static inline const std::vector<TexelBinding> kWords{{0, vk::Format::eR32Uint}};
   explicit Kernels(const GpuContext& c)
-      : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush)),
+      : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush), {}, kWords),
         blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush), {}, {{0, vk::Format::eR32G32Uint}}),
-        sobel(c, ShaderId::sobel_orientation, 2, 12),
-        vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush)),
-        pyr_down(c, ShaderId::pyr_down, 2, 16),
-        normals(c, ShaderId::depth_normals, 2, 16),
-        median(c, ShaderId::median5, 2, sizeof(SizePush)),
-        downsample(c, ShaderId::downsample_labels, 2, 12),
-        spread_rows(c, ShaderId::spread_rows, 2, 12),
-        spread(c, ShaderId::spread, 2, 12),
-        linearize(c, ShaderId::response_linearize, 2, 28, {}, {{0, vk::Format::eR32Uint}}) {}
+        sobel(c, ShaderId::sobel_orientation, 2, 12, {}, kWords),
+        vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush), {}, kWords),
+        pyr_down(c, ShaderId::pyr_down, 2, 16, {}, kWords),
+        normals(c, ShaderId::depth_normals, 2, 16, {}, {{0, vk::Format::eR16Uint}}),
+        median(c, ShaderId::median5, 2, sizeof(SizePush), {}, kWords),
+        downsample(c, ShaderId::downsample_labels, 2, 12, {}, kWords),
+        spread_rows(c, ShaderId::spread_rows, 2, 12, {}, kWords),
+        spread(c, ShaderId::spread, 2, 12, {}, kWords),
+        linearize(c, ShaderId::response_linearize, 2, 28, {}, kWords) {}
   Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
