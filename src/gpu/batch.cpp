@@ -34,6 +34,7 @@ Batch::Batch(const GpuContext& ctx) : ctx_(ctx), device_(ctx.state().device) {
 }
 
 Batch::~Batch() {
+  if (timestamp_pool_) device_.destroyQueryPool(timestamp_pool_);
   device_.destroyFence(fence_);
   device_.freeCommandBuffers(ctx_.state().command_pool, cmd_);
   for (auto pool : pools_) device_.destroyDescriptorPool(pool);
@@ -179,6 +180,27 @@ void Batch::download(const Buffer& src, void* dst, std::size_t bytes, std::size_
   downloads_.push_back({index, dst, bytes});
 }
 
+bool Batch::timestamps() const { return ctx_.state().timestamp_mask != 0 && !profile_; }
+
+uint32_t Batch::timestamp() {
+  if (!timestamps()) throw std::logic_error("gpu::Batch::timestamp: this queue writes no timestamps");
+  if (timestamps_recorded_ == kMaxTimestamps) throw std::logic_error("gpu::Batch::timestamp: too many in one submit");
+  if (!timestamp_pool_)
+    timestamp_pool_ = device_.createQueryPool({.queryType = vk::QueryType::eTimestamp, .queryCount = kMaxTimestamps});
+  begin();
+  if (timestamps_recorded_ == 0) cmd_.resetQueryPool(timestamp_pool_, 0, kMaxTimestamps);
+  cmd_.writeTimestamp(vk::PipelineStageFlagBits::eBottomOfPipe, timestamp_pool_, timestamps_recorded_);
+  return timestamps_recorded_++;
+}
+
+double Batch::millisecondsBetween(uint32_t first, uint32_t second) const {
+  if (first >= timestamp_values_.size() || second >= timestamp_values_.size())
+    throw std::logic_error("gpu::Batch::millisecondsBetween: no such timestamp in the last submit");
+  const auto& state = ctx_.state();
+  const uint64_t ticks = (timestamp_values_[second] - timestamp_values_[first]) & state.timestamp_mask;
+  return static_cast<double>(ticks) * state.timestamp_period_ns * 1e-6;
+}
+
 void Batch::submit() {
   if (!recording_) return;
   // Host reads of downloads and of host-visible buffers the kernels wrote.
@@ -193,6 +215,12 @@ void Batch::submit() {
   if (device_.waitForFences(fence_, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
     throw DeviceError("waiting for the GPU failed");
   device_.resetFences(fence_);
+  timestamp_values_.assign(timestamps_recorded_, 0);
+  if (timestamps_recorded_ > 0 &&
+      device_.getQueryPoolResults(timestamp_pool_, 0, timestamps_recorded_, timestamp_values_.size() * 8,
+                                  timestamp_values_.data(), 8, vk::QueryResultFlagBits::e64) != vk::Result::eSuccess)
+    throw DeviceError("reading the GPU timestamps failed");
+  timestamps_recorded_ = 0;
   for (const auto& d : downloads_) std::memcpy(d.dst, staging_[d.staging].mapped(), d.bytes);
   downloads_.clear();
   staging_used_ = 0;

@@ -62,6 +62,17 @@ class Batch {
   /// for reuse (staging buffers are kept).
   void submit();
 
+  /// Whether timestamp() works: the queue writes timestamps, and VKPOSE_PROFILE_KERNELS (a
+  /// submit per dispatch) is off.
+  bool timestamps() const;
+  /// Records a timestamp once everything recorded before it has finished; returns its index
+  /// for millisecondsBetween(), valid after the next submit(). At most kMaxTimestamps per
+  /// submit.
+  uint32_t timestamp();
+  /// Device time between two timestamps of the last submit, in milliseconds.
+  double millisecondsBetween(uint32_t first, uint32_t second) const;
+  static constexpr uint32_t kMaxTimestamps = 8;
+
  private:
   void begin();
   void bind(const Kernel& kernel, std::initializer_list<BufferView> buffers, const void* push, std::size_t push_bytes);
@@ -85,6 +96,9 @@ class Batch {
     std::size_t bytes;
   };
   std::vector<PendingDownload> downloads_;
+  vk::QueryPool timestamp_pool_;
+  uint32_t timestamps_recorded_ = 0;
+  std::vector<uint64_t> timestamp_values_;  ///< of the last submit
   bool recording_ = false;
   bool profile_ = false;  ///< VKPOSE_PROFILE_KERNELS=1: submit after each dispatch and time it
 };

@@ -250,6 +250,11 @@ GpuContext::GpuContext(const GpuOptions& options) : state_(std::make_unique<gpu:
         s.queue_family = i;
         break;
       }
+    if (s.queue_family < families.size() && families[s.queue_family].timestampValidBits > 0) {
+      const uint32_t bits = families[s.queue_family].timestampValidBits;
+      s.timestamp_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
+      s.timestamp_period_ns = s.physical.getProperties().limits.timestampPeriod;
+    }
     const float priority = 1.0f;
     vk::DeviceQueueCreateInfo queue_info{.queueFamilyIndex = s.queue_family,
                                          .queueCount = 1,

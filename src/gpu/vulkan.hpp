@@ -16,6 +16,10 @@ struct ContextState {
   vk::Device device;
   vk::Queue queue;
   uint32_t queue_family = 0;
+  /// Nanoseconds per timestamp tick, and the mask of valid timestamp bits on the queue (0:
+  /// the queue writes no timestamps).
+  double timestamp_period_ns = 0;
+  uint64_t timestamp_mask = 0;
   vk::CommandPool command_pool;
   vk::PhysicalDeviceMemoryProperties memory;
   GpuDeviceInfo info;
