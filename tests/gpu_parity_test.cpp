@@ -112,6 +112,29 @@ void expectMatchParity(const LinemodFrame& frame, const FeatureParams& params, i
   EXPECT_EQ(matcher.match(frame), ours);
   EXPECT_EQ(matcher.lastTimings().attempts, matcher.lastTimings().passes);
   EXPECT_GE(matcher.lastTimings().passes, 1u);
+  // Features and similarity share a submit where the queue has timestamps; both still get
+  // their own time.
+  EXPECT_GT(matcher.lastTimings().features_ms, 0.0);
+  EXPECT_GT(matcher.lastTimings().similarity_ms, 0.0);
+}
+
+TEST(GpuBatch, TimestampsTimeTheWorkBetweenThem) {
+  gpu::Batch batch(test::context());
+  if (!batch.timestamps()) GTEST_SKIP() << "this device's compute queue writes no timestamps";
+  gpu::Buffer buffer(test::context(), std::size_t{32} << 20);
+  const uint32_t before = batch.timestamp();
+  for (int i = 0; i < 4; ++i) batch.fill(buffer, static_cast<uint32_t>(i));
+  const uint32_t after = batch.timestamp();
+  batch.submit();
+  const double ms = batch.millisecondsBetween(before, after);
+  EXPECT_GT(ms, 0.0) << "filling 128 MiB took no time";
+  EXPECT_LT(ms, 60'000.0);
+  EXPECT_GE(batch.millisecondsBetween(after, after), 0.0);
+  EXPECT_THROW(batch.millisecondsBetween(before, after + 1), std::logic_error);
+  // The next submit starts a fresh set.
+  batch.fill(buffer, 0u);
+  batch.submit();
+  EXPECT_THROW(batch.millisecondsBetween(before, after), std::logic_error);
 }
 
 TEST(GpuParity, MatchesOnRealFramesBothModalities) {
