@@ -194,6 +194,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
 
   std::map<std::string, std::vector<double>> times;
   std::vector<double> totals, match_ms;
+  std::vector<std::size_t> detections;  // per timed frame, to compare with frames in flight
   for (int i = 0; i < o.warmup; ++i) {
     const DetectionResult r = detector.detect(frames[0].frame, frames[0].camera);
     for (const auto& [stage, ms] : r.timings_ms)
@@ -220,6 +221,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
     report.mean_matches += static_cast<double>(r.matches) / o.frames;
     report.mean_hypotheses += static_cast<double>(r.hypotheses) / o.frames;
     report.mean_detections += static_cast<double>(r.detections.size()) / o.frames;
+    detections.push_back(r.detections.size());
     report_progress("detect", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
   }
   for (const auto& [group, names] : stageGroups())
@@ -232,6 +234,23 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   for (const double t : totals) total_sum += t;
   report.stages.push_back({"total", median(totals), percentile(totals, 95), total_sum / o.frames});
   report.frames_per_s = total_sum > 0 ? 1000.0 * o.frames / total_sum : 0.0;
+  if (o.in_flight && o.frames > 1) {
+    // The same frames again, two in flight: the next frame's stages 1-2 on the GPU while
+    // this frame's CPU stages run.
+    std::vector<LinemodFrame> sequence;
+    std::vector<Camera> cameras;
+    for (int i = 0; i < o.frames; ++i) {
+      const BenchFrame& f = frames[static_cast<std::size_t>(i) % frames.size()];
+      sequence.push_back(f.frame);
+      cameras.push_back(f.camera);
+    }
+    std::vector<DetectionResult> results;
+    const double ms = timeMs([&] { results = detector.detectSequence(sequence, cameras); });
+    report.frames_per_s_in_flight = ms > 0 ? 1000.0 * o.frames / ms : 0.0;
+    for (std::size_t i = 0; i < results.size(); ++i)
+      report.in_flight_same_detections = report.in_flight_same_detections && results[i].detections.size() == detections[i];
+    report_progress("frames in flight", 1, 1);
+  }
   report.vkpose_match_ms = median(match_ms);
   const gpu::BufferMemory gpu_memory = gpu::bufferMemory();
   report.gpu_peak_bytes = gpu_memory.peak;
@@ -275,6 +294,11 @@ std::string formatDetectReport(const DetectBenchReport& r) {
     out += fmt::format("{:<14} {:>12.1f} {:>12.1f} {:>12.1f}\n", s.stage, s.median_ms, s.p95_ms, s.mean_ms);
   out += fmt::format("\n{:.3f} frames/s; per frame {:.0f} matches, {:.0f} hypotheses, {:.1f} detections\n",
                      r.frames_per_s, r.mean_matches, r.mean_hypotheses, r.mean_detections);
+  if (r.frames_per_s_in_flight > 0)
+    out += fmt::format("two frames in flight (the next frame's stages 1-2 during this frame's CPU stages): {:.3f} "
+                       "frames/s, {:.2f} x frame by frame{}\n",
+                       r.frames_per_s_in_flight, r.frames_per_s > 0 ? r.frames_per_s_in_flight / r.frames_per_s : 0.0,
+                       r.in_flight_same_detections ? "" : " (DIFFERENT detection counts: a bug)");
   out += fmt::format("template upload (first frame, not in total): {:.1f} ms\n", r.upload_ms);
   if (r.opencv_match_ms > 0)
     out += fmt::format("stages 1-2 vs cv::linemod (same templates, threshold, frames; median): vkpose {:.1f} ms, "
@@ -297,6 +321,7 @@ nlohmann::json detectReportJson(const DetectBenchReport& r) {
                       {"templates", r.templates},
                       {"stages", stages},
                       {"frames_per_s", r.frames_per_s},
+                      {"frames_per_s_in_flight", r.frames_per_s_in_flight},
                       {"upload_ms", r.upload_ms},
                       {"mean_matches", r.mean_matches},
                       {"mean_hypotheses", r.mean_hypotheses},

@@ -29,6 +29,9 @@ struct DetectBenchOptions {
   std::string data_dir;            ///< empty: ../shared/data as built in
   uint32_t seed = 1;               ///< synthetic frames
   bool run_opencv = true;
+  /// Also run the frames through Detector::detectSequence (two frames in flight) and report
+  /// its frames/s next to the frame-by-frame figure.
+  bool in_flight = true;
   DetectorParams params;
 };
 
@@ -49,6 +52,10 @@ struct DetectBenchReport {
   /// nms, initial_pose, mls, icp, verification (those that ran), then total.
   std::vector<StageStats> stages;
   double frames_per_s = 0;  ///< frames / sum of the frames' totals
+  /// frames / wall time of the same frames through detectSequence (two frames in flight; 0
+  /// when not run), and whether it found the same detections.
+  double frames_per_s_in_flight = 0;
+  bool in_flight_same_detections = true;
   double mean_matches = 0, mean_hypotheses = 0, mean_detections = 0;
   /// cv::linemod on the same frames with the same templates and threshold (0 when not run).
   double opencv_match_ms = 0;   ///< median per frame

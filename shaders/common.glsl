@@ -1,13 +1,15 @@
-// Shared by every kernel: byte/short storage, border rules and orientation bins. The C++
-// twins live in src/match/border.hpp and src/match/*_reference.cpp.
-#extension GL_EXT_shader_8bit_storage : require
-#extension GL_EXT_shader_16bit_storage : require
+// Shared by the feature kernels: pixel groups, packed pixels, border rules and orientation
+// bins. The C++ twins live in src/match/border.hpp and src/match/*_reference.cpp.
 #extension GL_EXT_control_flow_attributes : require
+#extension GL_EXT_samplerless_texture_functions : require
 
 // Sliding-window kernels take GROUP neighbouring outputs per invocation: neighbours share
-// most of their inputs, and on llvmpipe each byte or short load from a storage buffer is a
-// loop over the lanes. The loops over a group carry [[unroll]]: their small arrays must
-// be indexed by constants, an indexed local array being a loop over the lanes too.
+// most of their inputs. On llvmpipe a load from a storage buffer at a per-invocation
+// offset, and a store, is a loop over the lanes (a texel fetch is a gather), so the feature
+// kernels read their inputs as texel buffers and take several pixels per load and store:
+// colour as packed BGRX words, labels 4 to a word. The loops over a group carry [[unroll]]:
+// their small arrays must be indexed by constants, an indexed local array being a loop
+// over the lanes too.
 const int GROUP = 4;  // kPixelGroup in frame_features_gpu.cpp
 
 // Invocation i's group of GROUP neighbouring pixels of one row of a width x height image:
@@ -40,8 +42,8 @@ uint fromLanes(uint even, uint odd, uint shift) {
 
 // Label images (orientation bins, labels, spread labels) are packed 4 pixels per word, rows
 // of wordsPerRow(width) words, byte x % 4 of word x / 4 holding pixel x; the bytes past the
-// width are 0. Kernels on them take a word (4 neighbouring pixels) per invocation: one load
-// instead of four, each load being a loop over the lanes on llvmpipe.
+// width are 0. Kernels on them take a word (4 neighbouring pixels) per invocation: one fetch
+// and one store instead of four.
 int wordsPerRow(int width) { return (width + 3) / 4; }
 
 // Invocation i's word of a label image: row y, first pixel x0 (a multiple of 4). False past

@@ -155,6 +155,41 @@ TEST(DetectIcbin, WritesTheDetectionJsonScriptsRelyOn) {
   }
 }
 
+TEST(DetectIcbin, FramesInFlightFindWhatFrameByFrameFinds) {
+  // detectSequence starts each next frame's stages 1-2 on the GPU while the CPU stages of the
+  // current one run; the detections must not change.
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string d = test::sharedData() + "/icbin/";
+  const Camera camera = loadCamera(d + "camera.json");
+  std::vector<LinemodFrame> frames;
+  for (const char* scene : {"scene2/", "scene3/"})
+    for (const char* image : {"0000.png", "0001.png"})
+      frames.push_back(loadFrame(d + scene + "rgb/" + image, d + scene + "depth/" + image, camera.depth_scale));
+  Detector detector(test::context(), {icbinCupBank()}, DetectorParams{});
+  std::vector<DetectionResult> one_by_one;
+  for (const auto& f : frames) one_by_one.push_back(detector.detect(f, camera));
+  const auto in_flight = detector.detectSequence(frames, std::vector<Camera>(frames.size(), camera));
+  ASSERT_EQ(in_flight.size(), frames.size());
+  int found = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(in_flight[i].matches, one_by_one[i].matches) << "frame " << i;
+    ASSERT_EQ(in_flight[i].detections.size(), one_by_one[i].detections.size()) << "frame " << i;
+    for (std::size_t k = 0; k < in_flight[i].detections.size(); ++k) {
+      const Detection &a = in_flight[i].detections[k], &b = one_by_one[i].detections[k];
+      EXPECT_EQ(a.template_index, b.template_index);
+      EXPECT_FLOAT_EQ(a.score, b.score);
+      EXPECT_LT((a.pose.t - b.pose.t).norm(), 1e-3) << "frame " << i << " detection " << k;
+      ++found;
+    }
+  }
+  EXPECT_GT(found, 0) << "no detections to compare";
+  // A frame the sequence cannot use is reported on its turn, and the detector goes on.
+  std::vector<LinemodFrame> with_bad = {frames[0], frames[1]};
+  with_bad[1].depth_mm = cv::Mat::zeros(with_bad[1].depth_mm.size(), CV_16UC1);
+  EXPECT_THROW(detector.detectSequence(with_bad, {camera, camera}), InputError);
+  EXPECT_EQ(detector.detect(frames[0], camera).detections.size(), one_by_one[0].detections.size());
+}
+
 TEST(DetectionIo, RefusesToOverwriteWithoutForce) {
   const auto dir = std::filesystem::temp_directory_path() / "vkpose_detect_io_test";
   std::filesystem::create_directories(dir);

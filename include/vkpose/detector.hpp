@@ -100,6 +100,12 @@ class Detector {
   /// Throws InputError for a frame with no depth or a camera whose principal point lies
   /// outside it (the image size is the frame's).
   DetectionResult detect(const LinemodFrame& frame, const Camera& camera);
+  /// detect() on each frame in turn (cameras[i] for frames[i]) with two frames in flight:
+  /// once a frame's GPU stages are done, the next frame's stages 1-2 start on the GPU and run
+  /// while this frame's CPU stages (poses, verification) do. The same results as detect()
+  /// frame by frame; the features and similarity times are then the device's.
+  std::vector<DetectionResult> detectSequence(const std::vector<LinemodFrame>& frames,
+                                              const std::vector<Camera>& cameras);
 
   const std::vector<TemplateBank>& banks() const { return banks_; }
   const DetectorParams& params() const { return params_; }
@@ -112,6 +118,9 @@ class Detector {
   std::unique_ptr<ClusterScorer> scorer_;
   std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stage 6
 
+  const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running
+
+  DetectionResult detectFrame(const LinemodFrame& frame, const Camera& camera, const LinemodFrame* next);
   void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, DetectionResult& result);
 };
 

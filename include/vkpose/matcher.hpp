@@ -2,6 +2,7 @@
 // Stage 2, similarity (LINEMOD section 2.5 and OpenCV's Detector::match): every template is
 // scored at every position of the coarsest level, positions over the threshold are refined
 // in a 16 x 16 cell window at the next finer level.
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -55,11 +56,13 @@ struct MatchTimings {
 };
 
 namespace gpu {
+class Batch;
 class FrameFeatures;
 class Similarity;
 }  // namespace gpu
 
-/// Stages 1 and 2 on the GPU: one submit for the frame features, then one per similarity pass.
+/// Stages 1 and 2 on the GPU: one submit for the frame features and the first similarity
+/// pass (two without GPU timestamps), then one per further pass.
 class LinemodMatcher {
  public:
   LinemodMatcher(GpuContext& context, FeatureParams feature_params = {}, MatchParams params = {});
@@ -72,6 +75,13 @@ class LinemodMatcher {
   const std::vector<LinemodTemplate>& templates() const { return templates_; }
 
   std::vector<Match> match(const LinemodFrame& frame);
+  /// match() in two halves, for frames in flight: submit() starts a frame's stages 1-2 on the
+  /// GPU and returns at once; collect() waits for them and returns the matches (running
+  /// further passes if the candidates overflowed). The host may work in between; one frame
+  /// at a time. With GPU timestamps, the stage times are then the device's.
+  void submit(const LinemodFrame& frame);
+  std::vector<Match> collect();
+  bool inFlight() const { return pending_.active; }
   const MatchTimings& lastTimings() const { return timings_; }
 
   /// The frame features of the last match() (for parity tests and debugging).
@@ -90,6 +100,19 @@ class LinemodMatcher {
   /// (0: all); the next frame starts from it instead of failing its way down again.
   std::size_t chunks_per_pass_ = 0;
   MatchTimings timings_;
+  std::unique_ptr<gpu::Batch> batch_;
+  /// The frame between submit() and collect().
+  struct Pending {
+    bool active = false;     ///< submitted, not yet collected
+    bool submitted = false;  ///< its GPU work went out (false: no templates)
+    bool timestamps = false;
+    uint32_t features_begin = 0, features_end = 0, similarity_end = 0;
+    double features_record_ms = 0;
+    std::chrono::steady_clock::time_point started;
+    std::size_t per_pass = 0;
+  } pending_;
+  void submitFrame(const LinemodFrame& frame);
+  std::vector<Match> collectFrame(bool wall_clock);
 };
 
 }  // namespace vkpose

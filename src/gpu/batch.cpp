@@ -34,6 +34,8 @@ Batch::Batch(const GpuContext& ctx) : ctx_(ctx), device_(ctx.state().device) {
 }
 
 Batch::~Batch() {
+  // Nothing may be destroyed under work still running.
+  if (in_flight_) (void)device_.waitForFences(fence_, VK_TRUE, UINT64_MAX);
   if (timestamp_pool_) device_.destroyQueryPool(timestamp_pool_);
   device_.destroyFence(fence_);
   device_.freeCommandBuffers(ctx_.state().command_pool, cmd_);
@@ -43,6 +45,7 @@ Batch::~Batch() {
 
 void Batch::begin() {
   if (recording_) return;
+  wait();  // the command buffer, staging buffers and descriptor sets of a flushed batch
   cmd_.begin({.flags = vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
   recording_ = true;
 }
@@ -202,6 +205,11 @@ double Batch::millisecondsBetween(uint32_t first, uint32_t second) const {
 }
 
 void Batch::submit() {
+  flush();
+  wait();
+}
+
+void Batch::flush() {
   if (!recording_) return;
   // Host reads of downloads and of host-visible buffers the kernels wrote.
   vk::MemoryBarrier to_host{.srcAccessMask = vk::AccessFlagBits::eTransferWrite | vk::AccessFlagBits::eShaderWrite,
@@ -212,6 +220,12 @@ void Batch::submit() {
   recording_ = false;
   vk::SubmitInfo submit{.commandBufferCount = 1, .pCommandBuffers = &cmd_};
   ctx_.state().queue.submit(submit, fence_);
+  in_flight_ = true;
+}
+
+void Batch::wait() {
+  if (!in_flight_) return;
+  in_flight_ = false;
   if (device_.waitForFences(fence_, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
     throw DeviceError("waiting for the GPU failed");
   device_.resetFences(fence_);

@@ -61,6 +61,13 @@ class Batch {
   /// Submits everything recorded, waits, copies downloads to the host, and resets the batch
   /// for reuse (staging buffers are kept).
   void submit();
+  /// The first half of submit(): submits what was recorded and returns at once, so the host
+  /// can work while the device does. wait() (or anything recorded next) finishes it.
+  void flush();
+  /// The second half of submit(): waits for a flush(), copies downloads to the host, resets
+  /// the batch. Does nothing when nothing is in flight.
+  void wait();
+  bool inFlight() const { return in_flight_; }
 
   /// Whether timestamp() works: the queue writes timestamps, and VKPOSE_PROFILE_KERNELS (a
   /// submit per dispatch) is off.
@@ -100,6 +107,7 @@ class Batch {
   uint32_t timestamps_recorded_ = 0;
   std::vector<uint64_t> timestamp_values_;  ///< of the last submit
   bool recording_ = false;
+  bool in_flight_ = false;
   bool profile_ = false;  ///< VKPOSE_PROFILE_KERNELS=1: submit after each dispatch and time it
 };
 

@@ -121,6 +121,26 @@ Camera frameCamera(const LinemodFrame& frame, const Camera& frame_camera, const 
 }
 
 DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_camera) {
+  return detectFrame(frame, frame_camera, nullptr);
+}
+
+std::vector<DetectionResult> Detector::detectSequence(const std::vector<LinemodFrame>& frames,
+                                                      const std::vector<Camera>& cameras) {
+  if (frames.size() != cameras.size())
+    throw InputError(fmt::format("{} frames but {} cameras", frames.size(), cameras.size()));
+  std::vector<DetectionResult> results;
+  results.reserve(frames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    results.push_back(detectFrame(frames[i], cameras[i], i + 1 < frames.size() ? &frames[i + 1] : nullptr));
+  return results;
+}
+
+DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& frame_camera, const LinemodFrame* next) {
+  // A frame in flight that is not this one (an earlier frame threw before collecting it)
+  // is finished and dropped.
+  if (matcher_->inFlight() && in_flight_ != &frame) (void)matcher_->collect();
+  const bool submitted = matcher_->inFlight();
+  in_flight_ = nullptr;
   const Camera camera = frameCamera(frame, frame_camera, banks_.front().params.features);
   if (cv::countNonZero(frame.depth_mm) == 0) throw InputError("the depth image is all zero: nothing to detect");
 
@@ -135,7 +155,8 @@ DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_
   }
   auto t0 = std::chrono::steady_clock::now();
   const auto total0 = t0;
-  std::vector<Match> matches = matcher_->match(frame);
+  // Started while the previous frame's CPU stages ran (detectSequence), or now.
+  std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
   const MatchTimings& mt = matcher_->lastTimings();
   if (mt.upload_ms > 0) result.timings_ms.emplace_back("upload", mt.upload_ms);
   result.timings_ms.emplace_back("features", mt.features_ms);
@@ -171,6 +192,17 @@ DetectionResult Detector::detect(const LinemodFrame& frame, const Camera& frame_
     hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, params_.nms);
   }
   result.timings_ms.emplace_back("nms", msSince(t0));
+
+  // Frames in flight: the GPU is done with this frame (matching, cluster scores), so the next
+  // frame's stages 1-2 start there now and run while this frame's CPU stages do. A next frame
+  // the matcher refuses is left for its own turn to report.
+  if (next) {
+    try {
+      matcher_->submit(*next);
+      in_flight_ = next;
+    } catch (const InputError&) {
+    }
+  }
 
   if (params_.estimate_poses) {
     estimatePoses(hypotheses, scene, result);

@@ -34,11 +34,37 @@ void LinemodMatcher::setTemplates(std::vector<LinemodTemplate> templates) {
 }
 
 std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
+  submit(frame);
+  return collectFrame(true);
+}
+
+std::vector<Match> LinemodMatcher::collect() { return collectFrame(false); }
+
+void LinemodMatcher::submit(const LinemodFrame& frame) {
+  if (pending_.active) throw std::logic_error("LinemodMatcher::submit: a frame is in flight; collect() it first");
   validateFrame(frame, feature_params_);
   timings_ = {};
-  if (templates_.empty()) return {};
+  pending_ = {};
+  if (templates_.empty()) {
+    pending_.active = true;
+    return;
+  }
+  try {
+    submitFrame(frame);
+  } catch (...) {
+    // Nothing half-recorded may reach the next frame's submit.
+    pending_ = {};
+    batch_.reset();
+    throw;
+  }
+  pending_.active = true;
+  pending_.submitted = true;
+}
+
+void LinemodMatcher::submitFrame(const LinemodFrame& frame) {
   const cv::Size size = feature_params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
-  gpu::Batch batch(context_);
+  if (!batch_) batch_ = std::make_unique<gpu::Batch>(context_);
+  gpu::Batch& batch = *batch_;
   auto t0 = std::chrono::steady_clock::now();
   if (size != uploaded_for_) {
     layouts_ = match::makeLayouts(templates_, feature_params_, size.width, size.height);
@@ -48,39 +74,62 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
     chunks_per_pass_ = 0;
     timings_.upload_ms = msSince(t0);
   }
-  std::vector<match::CoarseCandidate> candidates, pass_candidates;
-  std::vector<match::RefineResult> refined, pass_refined;
   // One pass over all template chunks, unless the candidates outgrow what one binding holds
   // (many banks at a low threshold): then passes over fewer chunks each, features computed
   // once. A frame starts with the pass size the last one ended with: an overflowing pass
   // costs as much as one that fits.
-  std::size_t chunks = similarity_->chunkCount();
-  std::size_t per_pass = chunks_per_pass_ > 0 ? std::min(chunks_per_pass_, chunks) : chunks;
-  std::size_t most_candidates = 0;  // of one pass
+  const std::size_t chunks = similarity_->chunkCount();
+  pending_.per_pass = chunks_per_pass_ > 0 ? std::min(chunks_per_pass_, chunks) : chunks;
   // Features and the first similarity pass in one submit: GPU timestamps split its time,
   // features taking their recording (the frame's conversion and copy) and their device time.
   // Without timestamps, features go in a submit of their own. Either way they stay on the
   // device for every pass.
   t0 = std::chrono::steady_clock::now();
-  const bool one_submit = batch.timestamps();
-  const uint32_t features_begin = one_submit ? batch.timestamp() : 0;
+  pending_.timestamps = batch.timestamps();
+  if (pending_.timestamps) pending_.features_begin = batch.timestamp();
   features_->record(batch, frame, layouts_);
-  const uint32_t features_end = one_submit ? batch.timestamp() : 0;
-  const double features_record_ms = msSince(t0);
-  if (!one_submit) {
+  if (pending_.timestamps) pending_.features_end = batch.timestamp();
+  pending_.features_record_ms = msSince(t0);
+  if (!pending_.timestamps) {
     batch.submit();
     timings_.features_ms = msSince(t0);
+    t0 = std::chrono::steady_clock::now();
   }
+  similarity_->record(batch, *features_, 0, std::min(chunks, pending_.per_pass));
+  if (pending_.timestamps) pending_.similarity_end = batch.timestamp();
+  batch.flush();
+  pending_.started = t0;
+}
+
+std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
+  if (!pending_.active) throw std::logic_error("LinemodMatcher::collect: no frame in flight; submit() one first");
+  const Pending p = pending_;
+  pending_ = {};
+  if (!p.submitted) return {};  // no templates
+  gpu::Batch& batch = *batch_;
+  std::vector<match::CoarseCandidate> candidates, pass_candidates;
+  std::vector<match::RefineResult> refined, pass_refined;
+  std::size_t chunks = similarity_->chunkCount();
+  std::size_t per_pass = p.per_pass;
+  std::size_t most_candidates = 0;  // of one pass
   for (std::size_t begin = 0, attempt = 0, pass = 0; begin < chunks; ++pass) {
     const std::size_t end = std::min(chunks, begin + per_pass);
-    if (!one_submit || pass > 0) t0 = std::chrono::steady_clock::now();
-    similarity_->record(batch, *features_, begin, end);
-    batch.submit();
-    if (one_submit && pass == 0) {
-      const double all_ms = msSince(t0);
-      timings_.features_ms = features_record_ms + batch.millisecondsBetween(features_begin, features_end);
-      timings_.similarity_ms += std::max(0.0, all_ms - timings_.features_ms);
+    if (pass == 0) {
+      // Submitted by submit(). Run frame by frame (match()), the stages share the wall time
+      // from its start; with other work in between (frames in flight), similarity takes
+      // its device time.
+      batch.wait();
+      if (p.timestamps) {
+        timings_.features_ms = p.features_record_ms + batch.millisecondsBetween(p.features_begin, p.features_end);
+        timings_.similarity_ms = wall_clock ? std::max(0.0, msSince(p.started) - timings_.features_ms)
+                                            : batch.millisecondsBetween(p.features_end, p.similarity_end);
+      } else {
+        timings_.similarity_ms = msSince(p.started);
+      }
     } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      similarity_->record(batch, *features_, begin, end);
+      batch.submit();
       timings_.similarity_ms += msSince(t0);
     }
     ++timings_.attempts;
@@ -119,7 +168,7 @@ std::vector<Match> LinemodMatcher::match(const LinemodFrame& frame) {
   }
   // Passes that stayed under half a binding could cover twice the chunks next time.
   chunks_per_pass_ = most_candidates < similarity_->maxCandidates() / 2 ? std::min(chunks, 2 * per_pass) : per_pass;
-  t0 = std::chrono::steady_clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   timings_.chunks = chunks;
   timings_.coarse_candidates = candidates.size();
   auto matches = match::finishMatches(candidates, refined, templates_, feature_params_, params_);
