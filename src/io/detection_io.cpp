@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "io/image_file.hpp"
 #include "vkpose/detection_io.hpp"
 #include "vkpose/error.hpp"
 
@@ -247,12 +247,9 @@ cv::Mat drawDetectionsOn(cv::Mat out, const DetectionResult& result, const std::
 
 void writeImage(const std::string& path, const cv::Mat& image, bool overwrite) {
   refuseOverwrite(path, overwrite);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw InputError("cannot write " + path + ": " + e.what());
-  }
+  std::string why;
+  const bool ok = writeImageFile(path, image, why);
+  if (!why.empty()) throw InputError("cannot write " + path + ": " + why);
   if (!ok) throw InputError("cannot write " + path + " (use a .png name in an existing folder)");
 }
 
