@@ -8,7 +8,7 @@ set -uo pipefail
 
 out=${OUT:-gpu-out}
 mkdir -p "$out" /tmp/vkpose-bundle
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/.." || exit 1
 tar -xJf .gpu/vkpose-gpu.tar.xz -C /tmp/vkpose-bundle 2>/dev/null ||
   python3 -m tarfile -e .gpu/vkpose-gpu.tar.xz /tmp/vkpose-bundle || exit 1
 b=/tmp/vkpose-bundle/vkpose-gpu
