@@ -60,12 +60,20 @@ uint byteOf(uint word, int b) { return (word >> (8u * uint(b))) & 0xFFu; }
 // The bytes of the word at x0 that lie inside a row of `width` pixels.
 uint insideBytes(int x0, int width) { return width - x0 >= 4 ? 0xFFFFFFFFu : (1u << (8u * uint(width - x0))) - 1u; }
 
-// Pixel clamp(x, 0, width - 1) of a packed row, given its words at pixels x0 - 4, x0 and
-// x0 + 4 (x0 a multiple of 4; x within x0 - 4 .. x0 + 7): BORDER_REPLICATE for windows
-// of radius up to 4 around the word at x0.
-uint clampedByte(uint left, uint centre, uint right, int x, int x0, int width) {
+// The words at pixels x0 - 4, x0 and x0 + 4 of row `row` (its first word) of a packed label
+// image of `per_row` words a row, indices clamped to the row: what clampedByte reads.
+uvec3 wordsAround(utextureBuffer image, int row, int x0, int per_row) {
+  int xw = x0 / 4;
+  return uvec3(texelFetch(image, row + max(xw - 1, 0)).x, texelFetch(image, row + xw).x,
+               texelFetch(image, row + min(xw + 1, per_row - 1)).x);
+}
+
+// Pixel clamp(x, 0, width - 1) of a packed row, given its words around x0 (wordsAround;
+// x0 a multiple of 4; x within x0 - 4 .. x0 + 7): BORDER_REPLICATE for windows of radius up
+// to 4 around the word at x0.
+uint clampedByte(uvec3 words, int x, int x0, int width) {
   int t = clamp(x, 0, width - 1) - x0;
-  return byteOf(t < 0 ? left : t < 4 ? centre : right, t & 3);
+  return byteOf(t < 0 ? words.x : t < 4 ? words.y : words.z, t & 3);
 }
 
 // BORDER_REPLICATE

@@ -22,10 +22,9 @@ void main() {
   [[unroll]] for (int j = 0; j < 4; ++j) low[j] = high[j] = 0u;
   [[unroll]] for (int dy = -2; dy <= 2; ++dy) {
     int row = clampIndex(y + dy, pc.height) * per_row;
-    uint left = texelFetch(src, row + max(xw - 1, 0)).x, centre = texelFetch(src, row + xw).x,
-         right = texelFetch(src, row + min(xw + 1, per_row - 1)).x;
+    uvec3 words = wordsAround(src, row, x0, per_row);
     [[unroll]] for (int t = 0; t < 8; ++t) {
-      uint v = clampedByte(left, centre, right, x0 + t - 2, x0, pc.width);
+      uint v = clampedByte(words, x0 + t - 2, x0, pc.width);
       uint l = bitsToBytes(v & 15u), h = bitsToBytes(v >> 4);
       [[unroll]] for (int j = 0; j < 4; ++j)
         if (t >= j && t <= j + 4) {

@@ -20,11 +20,10 @@ void main() {
   uint centre_word = 0u;
   [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
     int row = clampIndex(y + dy, pc.height) * per_row;
-    uint left = texelFetch(bins, row + max(xw - 1, 0)).x, centre = texelFetch(bins, row + xw).x,
-         right = texelFetch(bins, row + min(xw + 1, per_row - 1)).x;
-    if (dy == 0) centre_word = centre;
+    uvec3 words = wordsAround(bins, row, x0, per_row);
+    if (dy == 0) centre_word = words.y;
     [[unroll]] for (int t = 0; t < 6; ++t) {
-      uint one = 1u << (4u * (clampedByte(left, centre, right, x0 + t - 1, x0, pc.width) & 7u));
+      uint one = 1u << (4u * (clampedByte(words, x0 + t - 1, x0, pc.width) & 7u));
       [[unroll]] for (int j = 0; j < 4; ++j) histogram[j] += t >= j && t <= j + 2 ? one : 0u;
     }
   }

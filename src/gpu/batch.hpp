@@ -67,7 +67,6 @@ class Batch {
   /// The second half of submit(): waits for a flush(), copies downloads to the host, resets
   /// the batch. Does nothing when nothing is in flight.
   void wait();
-  bool inFlight() const { return in_flight_; }
 
   /// Whether timestamp() works: the queue writes timestamps, and VKPOSE_PROFILE_KERNELS (a
   /// submit per dispatch) is off.

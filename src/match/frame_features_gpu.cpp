@@ -155,9 +155,9 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       // One invocation per 16 aligned padded cells of a pixel row and grid column
       // (response_linearize.comp).
       const int cells_x = (L.size.width + layout.T - 1) / layout.T;
-      const auto words = static_cast<std::size_t>((layout.pad + cells_x + 15) / 16 - layout.pad / 16);
+      const auto cell_groups = static_cast<std::size_t>((layout.pad + cells_x + 15) / 16 - layout.pad / 16);
       batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
-                           groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * words,
+                           groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * cell_groups,
                                      kGroup));
     }
   }
