@@ -1,4 +1,4 @@
-// libFuzzer target: the template bank reader (loadBank, src/io/bank_io.cpp). Each input is
+// libFuzzer target: the template bank reader (loadBank, src/training/bank_io.cpp). Each input is
 // read twice: as it is, and with its header's payload size and its checksum made to fit, so
 // that mutations reach the payload parser instead of stopping at the checksum.
 #include <cstring>

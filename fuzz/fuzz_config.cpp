@@ -1,4 +1,4 @@
-// libFuzzer target: the stage parameter file of `--config` (parseConfig, src/io/config_io.cpp;
+// libFuzzer target: the stage parameter file of `--config` (parseConfig, src/pipeline/config_io.cpp;
 // loadConfig reads the file and hands its text to parseConfig, so the text is fuzzed directly).
 // A file that parses is also merged with a command line's value, as the CLI does, and must
 // read back as it prints: what `vkpose config --print-defaults` writes, vkpose reads.
@@ -10,7 +10,7 @@
 #include "vkpose/config.hpp"
 
 namespace vkpose {
-// The cross-field checks live in src/hypotheses/detector.cpp next to the GPU detector, which
+// The cross-field checks live in src/pipeline/detector.cpp next to the GPU detector, which
 // the fuzz build does not compile (no Vulkan, PCL or OctoMap here). A no-op in their place:
 // this target covers the JSON reading and every per-field type and range check, not
 // validateDetectorParams (the Config tests in tests/demo_test.cpp cover that).
