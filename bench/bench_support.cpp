@@ -6,8 +6,11 @@
 #include <limits>
 #include <stdexcept>
 
+#include <fmt/core.h>
 #include <fmt/format.h>
 #include <sys/resource.h>
+
+#include "gpu/batch.hpp"
 
 namespace vkpose::bench {
 
@@ -178,6 +181,12 @@ std::string svgLinePlot(const PlotSpec& spec) {
   }
   svg += "</svg>\n";
   return svg;
+}
+
+void printKernelProfile() {
+  if (gpu::kernelProfile().empty()) return;
+  fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS; a submit per dispatch, so slower than a frame):\n");
+  for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
 }
 
 }  // namespace vkpose::bench

@@ -53,4 +53,7 @@ struct PlotSpec {
 /// has a point to draw.
 std::string svgLinePlot(const PlotSpec& spec);
 
+/// The per-kernel times VKPOSE_PROFILE_KERNELS=1 gathered over the whole run (nothing when off).
+void printKernelProfile();
+
 }  // namespace vkpose::bench

@@ -10,11 +10,15 @@
 
 #include "bench/bench_support.hpp"
 #include "gpu/buffer.hpp"
-#include "vkpose/camera.hpp"
+#include "hypotheses/hypotheses.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/hypotheses.hpp"
-#include "vkpose/opencv_linemod.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose::bench {

@@ -10,7 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "vkpose/detector.hpp"
-#include "vkpose/gpu_context.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose::bench {
 

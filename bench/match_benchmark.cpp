@@ -10,11 +10,13 @@
 
 #include "bench/bench_support.hpp"
 #include "gpu/buffer.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/opencv_linemod.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/frame.hpp"
 
 namespace vkpose::bench {
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "vkpose/gpu_context.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose::bench {
 

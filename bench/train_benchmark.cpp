@@ -6,9 +6,15 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rgbd/linemod.hpp>
 
-#include "cli/progress.hpp"
-#include "vkpose/opencv_linemod.hpp"
-#include "vkpose/template_bank.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
+#include "render/render.hpp"
+#include "training/training.hpp"
+#include "util/progress.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose::bench {
 
@@ -52,7 +58,7 @@ TrainBenchResult runTrainBenchmark(const TrainBenchOptions& options, const GpuOp
   params.views.viewpoints = options.viewpoints;
 
   // vkpose: the whole training, as `vkpose train` runs it.
-  cli::ProgressBar bar("training", !options.progress);
+  util::ProgressBar bar("training", !options.progress);
   TrainingTimings timings;
   const auto t0 = std::chrono::steady_clock::now();
   const TemplateBank bank =

@@ -3,7 +3,7 @@
 // selection) and, on the same renderings, OpenCV's cv::linemod::Detector::addTemplate.
 #include <string>
 
-#include "vkpose/gpu_context.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose::bench {
 

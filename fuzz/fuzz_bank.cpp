@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "fuzz/fuzz_support.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/bank.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   const std::string path = vkpose::fuzz::inputFile(data, size, "bank.vkpb");

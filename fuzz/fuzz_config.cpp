@@ -9,14 +9,6 @@
 #include "fuzz/fuzz_support.hpp"
 #include "vkpose/config.hpp"
 
-namespace vkpose {
-// The cross-field checks live in src/pipeline/detector.cpp next to the GPU detector, which
-// the fuzz build does not compile (no Vulkan, PCL or OctoMap here). A no-op in their place:
-// this target covers the JSON reading and every per-field type and range check, not
-// validateDetectorParams (the Config tests in tests/demo_test.cpp cover that).
-void validateDetectorParams(const DetectorParams&) {}
-}  // namespace vkpose
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   vkpose::fuzz::expectNoCrash([&] {

@@ -2,7 +2,8 @@
 // src/render/mesh.cpp). The first byte picks the format by the file's extension (STL, PLY,
 // OBJ: what vkpose documents), the rest is the file.
 #include "fuzz/fuzz_support.hpp"
-#include "vkpose/mesh.hpp"
+
+#include "vkpose/geometry.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   if (size < 1) return 0;

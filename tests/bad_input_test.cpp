@@ -19,14 +19,18 @@
 #include <opencv2/imgproc.hpp>
 
 #include "gpu/vulkan.hpp"
+#include "hypotheses/cluster_score.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
 #include "tests/mesh_support.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/dataset.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -5,10 +5,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/point_cloud.hpp"
-#include "vkpose/render.hpp"
+#include "vkpose/geometry.hpp"
+#include "pose/point_cloud.hpp"
+#include "render/render.hpp"
 
 namespace vkpose::test {
 

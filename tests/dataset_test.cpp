@@ -10,9 +10,9 @@
 #include <unistd.h>
 
 #include "tests/test_support.hpp"
-#include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/mesh.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -8,13 +8,17 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "eval/baselines.hpp"
+#include "match/matcher.hpp"
+#include "synth/placement.hpp"
+#include "synth/procedural_meshes.hpp"
 #include "test_support.hpp"
-#include "vkpose/bank_cache.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"
-#include "vkpose/demo.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/placement.hpp"
-#include "vkpose/procedural_meshes.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 #include "vkpose/synth.hpp"
 
 using namespace vkpose;

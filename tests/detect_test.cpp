@@ -7,11 +7,15 @@
 #include <opencv2/imgproc.hpp>
 #include <nlohmann/json.hpp>
 
+#include "hypotheses/cluster_score.hpp"
+#include "match/matcher.hpp"
 #include "test_support.hpp"
-#include "vkpose/detection_io.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -9,12 +9,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "eval/baselines.hpp"
+#include "hypotheses/cluster_score.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/baselines.hpp"
-#include "vkpose/dataset.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -3,9 +3,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rgbd/linemod.hpp>
 
+#include "match/features.hpp"
 #include "match/match_geometry.hpp"
+#include "match/matcher.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/opencv_linemod.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
 namespace {

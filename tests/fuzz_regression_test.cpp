@@ -10,14 +10,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "hypotheses/cluster_score.hpp"
+#include "match/matcher.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/camera.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"
-#include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/template_bank.hpp"
-#include "vkpose/views.hpp"
+#include "vkpose/geometry.hpp"
 
 // assimp's handler of its failed internal checks, which src/render/mesh.cpp defines.
 namespace Assimp {

@@ -3,10 +3,13 @@
 #include <cstdlib>
 
 #include "gpu/batch.hpp"
+#include "match/features.hpp"
 #include "match/frame_features_gpu.hpp"
 #include "match/match_geometry.hpp"
+#include "match/matcher.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/matcher.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose {
 namespace {

@@ -6,12 +6,17 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "hypotheses/cluster_score.hpp"
 #include "hypotheses/cluster_score_math.hpp"
+#include "hypotheses/hypotheses.hpp"
+#include "match/matcher.hpp"
+#include "synth/scene.hpp"
 #include "test_support.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/metrics.hpp"
-#include "vkpose/scene.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

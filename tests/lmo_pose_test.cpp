@@ -6,11 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include "hypotheses/cluster_score.hpp"
 #include "test_support.hpp"
-#include "vkpose/dataset.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

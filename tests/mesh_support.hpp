@@ -1,7 +1,7 @@
 #pragma once
 // Meshes built in code for the render and training tests: exact shapes whose depth can be
 // computed by ray casting.
-#include "vkpose/mesh.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose::test {
 

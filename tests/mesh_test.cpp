@@ -4,13 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include "mesh_support.hpp"
 #include "test_support.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/views.hpp"
-
-#include <Eigen/LU>
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "tests/test_support.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
 
 namespace vkpose {
 namespace {

@@ -14,9 +14,12 @@
 
 #include <opencv2/rgbd/linemod.hpp>
 
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
 #include "tests/test_support.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/opencv_linemod.hpp"
+#include "training/training.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
 namespace {

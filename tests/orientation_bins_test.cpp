@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose {
 namespace {

@@ -8,10 +8,15 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "hypotheses/hypotheses.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "pose/initial_pose.hpp"
+#include "render/render.hpp"
 #include "tests/test_support.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/initial_pose.hpp"
-#include "vkpose/mesh.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

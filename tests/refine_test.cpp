@@ -13,13 +13,12 @@
 
 #include "cloud_support.hpp"
 #include "mesh_support.hpp"
+#include "pose/point_cloud.hpp"
+#include "pose/refine.hpp"
 #include "test_support.hpp"
-#include "vkpose/camera.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/refine.hpp"
-#include "vkpose/views.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -7,10 +7,11 @@
 
 #include "gpu/buffer.hpp"
 #include "mesh_support.hpp"
+#include "render/render.hpp"
 #include "test_support.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/render.hpp"
-#include "vkpose/views.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

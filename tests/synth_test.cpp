@@ -11,10 +11,11 @@
 #include <unistd.h>
 
 #include "mesh_support.hpp"
+#include "synth/placement.hpp"
 #include "test_support.hpp"
-#include "vkpose/bop_writer.hpp"
-#include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose {

@@ -4,11 +4,14 @@
 #include <memory>
 #include <random>
 
-
-#include "vkpose/bank_cache.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
-#include "vkpose/opencv_linemod.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose::test {
 

@@ -9,10 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "vkpose/features.hpp"
-#include "vkpose/gpu_context.hpp"
-#include "vkpose/template_bank.hpp"
-#include "vkpose/templates.hpp"
+#include "match/features.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose::test {
 

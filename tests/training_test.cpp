@@ -10,11 +10,14 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "match/matcher.hpp"
 #include "mesh_support.hpp"
+#include "render/render.hpp"
 #include "test_support.hpp"
+#include "training/training.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "gpu/vulkan.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/gpu_context.hpp"
 
 namespace vkpose {
 namespace {

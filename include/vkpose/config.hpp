@@ -1,14 +1,175 @@
 #pragma once
-// Stage parameters in a file (`--config FILE`): every DetectorParams field, grouped by stage,
-// as JSON. `vkpose config --print-defaults` writes the defaults to start from.
+// The detector's parameters, one struct per stage with the paper's or the measured defaults and
+// what each does, and the config file (`--config FILE`) that sets them: every DetectorParams
+// field, grouped by stage, as JSON. `vkpose config --print-defaults` writes the defaults.
 #include <cstddef>
 #include <string>
 #include <variant>
 #include <vector>
 
-#include "vkpose/detector.hpp"
-
 namespace vkpose {
+
+// ---- stage parameters ------------------------------------------------------------------
+
+struct MatchParams {
+  /// Similarity in percent a match needs; 0 % is what a random image gives (half the maximum
+  /// response per feature), 100 % a perfect match (OpenCV's convention).
+  float threshold = 80.0f;
+};
+
+struct ClusterParams {
+  /// s_im: the object centres of matches are quantized into cells of this many pixels. The
+  /// paper used about 12, and 12 ranked best here too (docs/pipeline.md, stage 3).
+  int position_step_px = 12;
+  /// tau_c: clusters of fewer distinct templates are noise (a lone template matching clutter).
+  int min_templates = 3;
+};
+
+struct ScoreParams {
+  float depth_unit_m = 0.01f;      ///< alpha's unit: alpha = exp(-error / unit)
+  float depth_cap_m = 0.02f;       ///< per-cell depth errors are truncated here (occluders, background)
+  float angle_unit_rad = 0.5f;     ///< beta's unit: beta = exp(-mean angle / unit)
+  /// Scene normals: cross product of depth differences `normal_step_px` pixels either side;
+  /// a difference larger than `normal_max_jump_m` is a depth edge (no normal there).
+  int normal_step_px = 2;
+  float normal_max_jump_m = 0.01f;
+  /// A template must find scene depth on this share of its object cells, else it scores 0
+  /// (no evidence: a hole in the depth map, or the template hangs over the image border).
+  float min_valid_fraction = 0.5f;
+  /// Members scored per hypothesis, best similarity first (0: all).
+  int max_members = 32;
+  /// alpha and beta pool this many best-fitting members (missing ones count as misfits).
+  int top_members = 3;
+};
+/// Throws InputError naming the bad value.
+void validateScoreParams(const ScoreParams& params);
+
+struct NmsParams {
+  /// r: a hypothesis is suppressed by a better one whose centre lies within this many
+  /// pixels. 0: per pair, `radius_fraction` of the larger projected object diameter.
+  float radius_px = 0.f;
+  float radius_fraction = 0.5f;
+  /// Suppress across objects too (one place in the image holds one object).
+  bool across_objects = true;
+};
+
+struct InitialPoseParams {
+  /// tau_theta: template rotations closer than this (axis-angle distance to a group's mean,
+  /// degrees) vote for the same rotation (the paper: 10 degrees).
+  float rotation_cluster_deg = 10.f;
+  /// A scene pixel under the rendered mask belongs to the object when its depth lies within
+  /// this fraction of the object's diameter of the rendered depth there. Nearer is an
+  /// occluder, farther is what lies behind the object (the mask is still misplaced by up to a
+  /// few centimetres at this stage).
+  float depth_band_fraction = 0.3f;
+  /// The scene crop that refinement and verification see: the rendered object's box grown by
+  /// this fraction of its size on every side, depths within the band of the rendered range.
+  float crop_margin_fraction = 0.25f;
+  /// Fewer scene points than this under the mask (a black hole in the depth map, an object
+  /// seen through a gap): the hypothesis is rejected.
+  std::size_t min_scene_points = 50;
+};
+/// Throws InputError naming the bad value.
+void validateInitialPoseParams(const InitialPoseParams& params);
+
+struct RefineParams {
+  /// Moving least squares smoothing of the scene crop before registration.
+  bool mls = true;
+  /// MLS neighbourhood radius, metres. At 0.7 m a Kinect-class sensor samples about every
+  /// 1.2 mm, so 1 cm holds ~200 points: enough to average its 1-3 mm depth noise down with a
+  /// quadric fit, yet small against the 10-20 cm LM-O objects, so edges and curvature survive.
+  float mls_radius = 0.01f;
+  int mls_polynomial_order = 2;  ///< 2: quadric fit (follows curved surfaces); 1: plane
+  /// true: fit MLS only at one seed point per voxel_size voxel (the neighbourhoods still hold
+  /// every point), since the voxel grid keeps one point per voxel anyway: the same smoothing
+  /// for about a third of the work (LM-O crop of 8.8k points: 23 vs 68 ms). false: fit at
+  /// every point, then voxel-filter (the paper's literal order).
+  bool mls_at_voxel_seeds = true;
+  /// Both clouds are voxel-filtered to this leaf size (metres), so that each surface patch
+  /// weighs the same in the fit whatever the sensor's or the model's sampling. 0: no filter.
+  float voxel_size = 0.004f;
+  /// Coarse stage: max correspondence distance = this fraction of the largest distance among
+  /// the current nearest-neighbour pairs, recomputed each iteration (the paper: 90%).
+  float coarse_fraction = 0.9f;
+  float fine_fraction = 0.45f;  ///< fine stage, the same with 45% (the paper)
+  int coarse_iterations = 30;   ///< iteration limit of the coarse stage (0: skip it)
+  int fine_iterations = 30;     ///< iteration limit of the fine stage (0: skip it)
+  /// A stage has converged when one iteration moves the pose by less than this: squared
+  /// translation (m^2) and 1 - cos(rotation angle), PCL's transformation epsilon criterion.
+  double convergence_epsilon = 1e-6;
+  /// Fewer points than this in either filtered cloud, or fewer pairs within the threshold:
+  /// no registration (converged = false).
+  std::size_t min_points = 10;
+  /// Baseline for comparison: > 0 replaces the two adaptive stages by one plain
+  /// pcl::IterativeClosestPoint run with this fixed max correspondence distance (metres) and
+  /// coarse_iterations + fine_iterations iterations. Filtering is unchanged.
+  float fixed_max_correspondence_m = 0.f;
+};
+/// Throws InputError naming the bad value.
+void validateRefineParams(const RefineParams& params);
+
+struct VerifyParams {
+  /// Octree leaf size, metres. Real depth is noisy: on LM-O (object 5, about 1 m away) a
+  /// correct refined pose scored 0.50 at 4 mm and 0.77 at 8 mm, a pose 2 cm off at most 0.15
+  /// and 0.35 (tests/verify_test.cpp). Tune with the threshold.
+  float resolution = 0.004f;
+  /// Accept if the collision rate exceeds this. Measured on LM-O (scene 2, image 3) at 4 mm
+  /// leaves: correct refined poses 0.42-0.64, wrong ones that pass the other two tests up to 0.38.
+  float threshold = 0.4f;
+  float crop_margin = 0.02f;  ///< scene points within the model's box grown by this (metres) go in the octree
+  /// Free-space test: a visible model point whose pixel sees the scene this much (metres)
+  /// farther away cannot be there (the camera looks through it). The collision rate alone
+  /// accepts a flat face of a model laid on any flat surface; the points that stick out of it
+  /// then float in front of that surface.
+  float see_through_tolerance = 0.015f;
+  /// Accept only if at most this share of the visible model points (with scene depth) is
+  /// seen through.
+  float max_see_through = 0.15f;
+  /// Silhouette test: an object that stands where it is claimed shows a depth step along most
+  /// of its outline (the background lies farther). A model sunk into a table or a wall, with
+  /// one flat face flush with it, fits the depth everywhere and has a collision rate as high
+  /// as a true object's (measured on LM-O: a hole puncher laid into the paper markers, phi
+  /// 0.59), but shows no step. A step is a jump of at least `silhouette_jump` metres.
+  float silhouette_jump = 0.01f;
+  /// Accept only if at least this share of the outline's samples (where the scene has depth
+  /// on both sides, and nothing nearer outside) steps back.
+  float min_silhouette_support = 0.55f;
+};
+/// Throws InputError naming the bad value.
+void validateVerifyParams(const VerifyParams& params);
+
+struct DetectorParams {
+  MatchParams match;
+  ClusterParams cluster;
+  ScoreParams score;
+  NmsParams nms;
+  /// Without stages 6-8 (estimate_poses false): hypotheses whose cluster score gamma is below
+  /// this are dropped before NMS (a cluster on clutter, a template that fits the colour edges
+  /// but not the depth).
+  float min_score = 0.15f;
+  /// With stages 6-8: hypotheses with gamma from this up go through NMS within their object,
+  /// and the best pose_candidates_per_object of each object get a pose; verification, not
+  /// gamma, then decides. On real Kinect depth at 1 m, gamma of a correct hypothesis can be as
+  /// low as 0.13 (LM-O), and a cluttered object's best hypothesis can rank below hundreds of
+  /// other objects' ones, so one global gamma cut and NMS across objects would lose it.
+  float pose_min_score = 0.05f;
+  int pose_candidates_per_object = 16;
+  /// Stages 6-8 (initial pose, MLS + ICP, octree verification). false: stop after NMS and
+  /// report the best template's pose, unverified.
+  bool estimate_poses = true;
+  InitialPoseParams initial_pose;
+  RefineParams refine;
+  VerifyParams verify;
+  /// Two accepted poses whose object centres are closer than this fraction of the smaller
+  /// diameter claim the same space: only the better one is kept (two clusters of one
+  /// instance that NMS kept apart in the image converge to one place after ICP).
+  float duplicate_fraction = 0.3f;
+  unsigned threads = 0;  ///< CPU threads for the per-hypothesis stages (0: all cores)
+};
+/// Throws InputError naming the first bad value of any stage.
+void validateDetectorParams(const DetectorParams& params);
+
+// ---- the config file ------------------------------------------------------------------
 
 /// One parameter: where it lives in the file ("section": {"key": value}), what it means (with
 /// its unit), and the field it sets.

@@ -1,55 +1,28 @@
 #pragma once
-// The detector facade: chains the stages (features and similarity on the GPU, clustering,
-// cluster score, NMS, initial pose, refinement, verification) for several objects at once and
-// records the time of each stage. It owns no algorithm of its own; every stage is callable
-// alone (matcher.hpp, hypotheses.hpp, cluster_score.hpp, initial_pose.hpp, refine.hpp,
-// verify.hpp).
+// The detector: chains the stages (features and similarity on the GPU, clustering, cluster
+// score, NMS, initial pose, refinement, verification) for several objects at once and records
+// the time of each stage; what it finds (Detection), and what `vkpose detect` writes: the
+// detection JSON (docs/formats.md), which scripts rely on, and an overlay PNG.
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "vkpose/cluster_score.hpp"
-#include "vkpose/hypotheses.hpp"
-#include "vkpose/initial_pose.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/refine.hpp"
-#include "vkpose/verify.hpp"
-#include "vkpose/template_bank.hpp"
+#include <opencv2/core.hpp>
+
+#include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 
-struct DetectorParams {
-  MatchParams match;
-  ClusterParams cluster;
-  ScoreParams score;
-  NmsParams nms;
-  /// Without stages 6-8 (estimate_poses false): hypotheses whose cluster score gamma is below
-  /// this are dropped before NMS (a cluster on clutter, a template that fits the colour edges
-  /// but not the depth).
-  float min_score = 0.15f;
-  /// With stages 6-8: hypotheses with gamma from this up go through NMS within their object,
-  /// and the best pose_candidates_per_object of each object get a pose; verification, not
-  /// gamma, then decides. On real Kinect depth at 1 m, gamma of a correct hypothesis can be as
-  /// low as 0.13 (LM-O), and a cluttered object's best hypothesis can rank below hundreds of
-  /// other objects' ones, so one global gamma cut and NMS across objects would lose it.
-  float pose_min_score = 0.05f;
-  int pose_candidates_per_object = 16;
-  /// Stages 6-8 (initial pose, MLS + ICP, octree verification). false: stop after NMS and
-  /// report the best template's pose, unverified.
-  bool estimate_poses = true;
-  InitialPoseParams initial_pose;
-  RefineParams refine;
-  VerifyParams verify;
-  /// Two accepted poses whose object centres are closer than this fraction of the smaller
-  /// diameter claim the same space: only the better one is kept (two clusters of one
-  /// instance that NMS kept apart in the image converge to one place after ICP).
-  float duplicate_fraction = 0.3f;
-  unsigned threads = 0;  ///< CPU threads for the per-hypothesis stages (0: all cores)
-};
-
-/// Throws InputError naming the first bad value of any stage.
-void validateDetectorParams(const DetectorParams& params);
+// Stage internals the Detector holds (src/).
+class LinemodMatcher;
+class ClusterScorer;
+class MeshRenderer;
+struct Hypothesis;
+struct ScoreScene;
 
 /// One detected object instance.
 struct Detection {
@@ -124,15 +97,41 @@ class Detector {
   void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, DetectionResult& result);
 };
 
-/// Checks a frame and its camera for detection and returns the camera with the frame's size
-/// (scene_camera.json entries carry none). Throws InputError for a bad frame (validateFrame), a
-/// bad camera, or a principal point outside the frame (intrinsics of another camera).
-Camera frameCamera(const LinemodFrame& frame, const Camera& camera, const FeatureParams& features);
+// ---- detections to files --------------------------------------------------------------
 
-/// The pose a hypothesis's template implies: the template's rotation turned onto the viewing
-/// ray through the hypothesis centre, at the template's distance moved by the member's mean
-/// depth offset.
-Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
-                  const Camera& camera);
+/// Where a result came from, for the JSON's header fields.
+struct DetectionSource {
+  std::string rgb, depth, device;
+};
+
+/// The detection JSON document: {"rgb", "depth", "device", "detections": [{"object", "score",
+/// "bbox": [x, y, w, h], "R": [9, row-major], "t": [metres], "collision_rate", "icp_fitness",
+/// "templates", ...}], "rejected": [the same, with "reason"], "timings_ms": {stage: ms}},
+/// pretty-printed.
+std::string detectionJson(const DetectionResult& result, const DetectionSource& source);
+
+struct OverlayOptions {
+  bool show_rejected = false;  ///< also draw the hypotheses stages 6-8 rejected, in red
+  bool legend = true;          ///< the counts per object and what the label numbers mean
+  /// When set (16-bit, millimetres, the colour image's size): the depth in false colour with
+  /// the same drawing, to the right of the colour image.
+  cv::Mat depth_mm;
+};
+
+/// The colour image with every detection drawn in its object's colour: for a refined pose the
+/// projected model outline and its axes (x red, y green, z blue), otherwise the template's box
+/// and centre; a label (index, object, score, collision rate) and a legend. `banks` and
+/// `camera` are the detector's (the meshes and the intrinsics the poses refer to).
+cv::Mat drawDetections(const cv::Mat& bgr, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                       const Camera& camera, const OverlayOptions& options = {});
+
+/// drawDetections onto an image of the frame's size that the caller prepared (e.g. a depth
+/// rendering), in place; returns it.
+cv::Mat drawDetectionsOn(cv::Mat image, const DetectionResult& result, const std::vector<TemplateBank>& banks,
+                         const Camera& camera, const OverlayOptions& options = {});
+
+/// The outer contours of a mesh projected at `pose`, in pixels (its silhouette; no depth test
+/// is needed for that).
+std::vector<std::vector<cv::Point>> silhouette(const Mesh& mesh, const Pose& pose, const Camera& camera);
 
 }  // namespace vkpose

@@ -1,18 +1,351 @@
 #pragma once
-// Methods side by side on a BOP dataset (`vkpose eval`): the full pipeline (Detector) and the
-// paper's two baselines (baselines.hpp) run on the same images, each scored with the paper's
-// protocol (metrics.hpp), each timed per image.
+// Evaluation on BOP datasets (`vkpose eval`): reading datasets (scenes, ground truth, cameras,
+// models), the paper's protocol (ADD/ADI under k_m * d, one-to-one matching, precision, recall,
+// F1), the BOP results CSV, writing BOP files (synth), and the full pipeline and the paper's two
+// baselines (LINEMOD alone, PPF) run side by side on the same images.
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
 #include <vector>
 
-#include "vkpose/baselines.hpp"
-#include "vkpose/dataset.hpp"
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/detector.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
+
+// ---- BOP datasets ----------------------------------------------------------------------
+
+/// One annotated object instance of an image (BOP scene_gt.json, with visib_fract from
+/// scene_gt_info.json when the dataset has it).
+struct GroundTruthPose {
+  int obj_id = 0;
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera rotation (cam_R_m2c)
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();      ///< object-to-camera translation, metres
+  float visib_fract = 1.f;                          ///< visible share of the object's silhouette, 0..1
+};
+
+/// One entry of a BOP scene_gt_info.json (the same order as the image's scene_gt.json list).
+struct GroundTruthInfo {
+  cv::Rect bbox_obj;        ///< box of the whole silhouette, pixels ([-1 -1 -1 -1] in BOP: none)
+  cv::Rect bbox_visib;      ///< box of the visible part, pixels
+  int px_count_all = 0;     ///< pixels of the whole silhouette
+  int px_count_valid = 0;   ///< ... of which with a valid depth
+  int px_count_visib = 0;   ///< visible pixels
+  float visib_fract = 1.f;  ///< px_count_visib / px_count_all
+};
+
+/// One object of BOP's models_info.json.
+struct ModelInfo {
+  int obj_id = 0;
+  float diameter = 0.f;                                 ///< largest distance between two model points, metres
+  Eigen::Vector3f bbox_min = Eigen::Vector3f::Zero();   ///< min_x, min_y, min_z, metres
+  Eigen::Vector3f bbox_size = Eigen::Vector3f::Zero();  ///< size_x, size_y, size_z, metres
+  /// The file lists discrete or continuous symmetries: poses are scored with ADI, not ADD.
+  bool symmetric = false;
+};
+
+/// One image of a BOP split with its camera and ground truth.
+struct BopImage {
+  int scene_id = 0, image_id = 0;
+  std::string rgb_path, depth_path;  ///< rgb/%06d.png (or .jpg), depth/%06d.png
+  Camera camera;                     ///< scene_camera.json's cam_K and depth_scale, size from camera.json
+  std::vector<GroundTruthPose> gt;
+  std::vector<GroundTruthInfo> gt_info;  ///< parallel to gt; empty when the scene has no scene_gt_info.json
+};
+
+/// A BOP dataset: models and the images of one split that have ground truth.
+struct BopDataset {
+  std::string root;
+  std::string split;
+  Camera camera;                    ///< the dataset's camera.json
+  std::map<int, ModelInfo> models;  ///< by obj_id
+  std::vector<BopImage> images;     ///< sorted by (scene_id, image_id)
+
+  std::string modelPath(int obj_id) const;  ///< root/models/obj_%06d.ply
+  /// root/models_eval/obj_%06d.ply (BOP's decimated models for pose errors) when it exists,
+  /// otherwise modelPath(obj_id).
+  std::string evalModelPath(int obj_id) const;
+};
+
+/// scene_gt.json: image id -> instances, in the file's order. visib_fract stays 1.
+std::map<int, std::vector<GroundTruthPose>> loadSceneGt(const std::string& path);
+
+/// scene_gt_info.json: image id -> per-instance visibility, in the file's order.
+std::map<int, std::vector<GroundTruthInfo>> loadSceneGtInfo(const std::string& path);
+
+/// scene_camera.json: image id -> camera. cam_K gives fx, fy, cx, cy and depth_scale the
+/// depth scale when present; the image size and a missing depth_scale come from `base`.
+std::map<int, Camera> loadSceneCamera(const std::string& path, const Camera& base = {});
+
+/// models_info.json: obj_id -> diameter, box and symmetry flag, in metres.
+std::map<int, ModelInfo> loadModelsInfo(const std::string& path);
+
+/// Reads root/camera.json, root/models/models_info.json and every scene root/split/%06d/ with
+/// its scene_gt.json and scene_camera.json (scene_gt_info.json optional: visib_fract 1 without
+/// it). Images are those of scene_gt.json; each needs its camera entry, a depth PNG and an rgb
+/// PNG or JPG, and every annotated obj_id must be in models_info.json.
+BopDataset loadBopDataset(const std::string& root, const std::string& split = "test");
+
+/// A pose file of Tejani et al. 2014 (posesN.txt): the number of instances on the first line,
+/// then that many 4x4 row-major object-to-camera matrices, translation in metres. Throws
+/// InputError with the file and the line when the count does not match the matrices, a value
+/// is not a finite number, the last row is not 0 0 0 1, or R is not a rotation
+/// (an entry of R^T R - I over 1e-2, or det R < 0). Rotations are returned as read, not
+/// re-orthonormalized.
+std::vector<Pose> loadTejaniPoses(const std::string& path);
+
+// ---- the protocol: pose errors, one-to-one matching, scores, the results CSV -----------
+
+/// One pose an estimator returned for an image.
+struct PoseEstimate {
+  int obj_id = 0;
+  float score = 0.f;                                ///< higher is better; decides the matching order
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera rotation
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();      ///< object-to-camera translation, metres
+};
+
+/// Exact nearest-neighbour distances to a fixed point set (a k-d tree whose nodes are the
+/// medians of index ranges, stored in place). For ADI.
+class PointIndex {
+ public:
+  PointIndex() = default;
+  explicit PointIndex(std::vector<Eigen::Vector3f> points);
+
+  /// The points, reordered into tree order.
+  const std::vector<Eigen::Vector3f>& points() const { return points_; }
+  /// Euclidean distance from q to the nearest point; infinity when there are no points.
+  float nearestDistance(const Eigen::Vector3f& q) const;
+
+ private:
+  void build(std::size_t lo, std::size_t hi);
+  void search(std::size_t lo, std::size_t hi, const Eigen::Vector3f& q, float& best_sq) const;
+
+  std::vector<Eigen::Vector3f> points_;
+  std::vector<uint8_t> axis_;  ///< split axis of the node at the midpoint of each range
+};
+
+/// ADD: mean distance between corresponding model points under the two poses (metres, like
+/// the points).
+float addError(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3f& R_est, const Eigen::Vector3f& t_est,
+               const Eigen::Matrix3f& R_gt, const Eigen::Vector3f& t_gt);
+
+/// ADI: mean over the points under the ground-truth pose of the distance to the closest point
+/// under the estimated pose. R_est must be a rotation (the search runs in its object frame; the
+/// 1e-2 tolerance of the readers changes distances by at most about 1%).
+float adiError(const PointIndex& points, const Eigen::Matrix3f& R_est, const Eigen::Vector3f& t_est,
+               const Eigen::Matrix3f& R_gt, const Eigen::Vector3f& t_gt);
+
+/// Which pose error scores an object.
+enum class PoseErrorType {
+  Auto,  ///< ADI for objects whose ModelInfo is symmetric, ADD otherwise
+  ADD,   ///< ADD for every object
+  ADI,   ///< ADI for every object
+};
+
+/// What scoring one object needs: its info (diameter, symmetry) and its model points.
+struct EvalModel {
+  ModelInfo info;
+  PointIndex points;  ///< model vertices, metres, object frame
+};
+
+/// Throws InputError when there are no points or the diameter is not positive.
+EvalModel makeEvalModel(const ModelInfo& info, std::vector<Eigen::Vector3f> points);
+
+/// Every model of the dataset, its vertices read from evalModelPath (BOP's models_eval, in
+/// millimetres).
+std::map<int, EvalModel> loadEvalModels(const BopDataset& dataset);
+
+struct EvalParams {
+  float k_m = 0.15f;  ///< an estimate is correct when its error is below k_m * diameter
+  PoseErrorType error = PoseErrorType::Auto;
+  /// Instances whose visib_fract is below this are left out of the scores: not a false
+  /// negative when missed, and an estimate matched to one counts as neither a true nor a false
+  /// positive. They still take part in the matching. 0 (default) counts every instance.
+  float min_visib_fract = 0.f;
+};
+
+/// ADD or ADI between an estimate and an instance of the same object, as `type` (Auto: from
+/// model.info.symmetric) says. Metres.
+float poseError(const EvalModel& model, const PoseEstimate& est, const GroundTruthPose& gt,
+                PoseErrorType type = PoseErrorType::Auto);
+
+/// Detections counted over any number of images.
+struct EvalCounts {
+  int tp = 0;  ///< estimates matched to an instance
+  int fp = 0;  ///< estimates matched to none
+  int fn = 0;  ///< instances no estimate matched
+  EvalCounts& operator+=(const EvalCounts& o) {
+    tp += o.tp;
+    fp += o.fp;
+    fn += o.fn;
+    return *this;
+  }
+};
+
+/// What became of one estimate.
+struct EstimateMatch {
+  int gt = -1;           ///< index into the image's ground truth; -1: a false positive
+  float error = 0.f;     ///< the pose error to that instance, metres (0 when unmatched)
+  bool ignored = false;  ///< matched an instance below min_visib_fract: neither TP nor FP
+};
+
+struct ImageEvaluation {
+  std::vector<EstimateMatch> matches;  ///< parallel to the estimates
+  std::map<int, EvalCounts> counts;    ///< by obj_id, for every object estimated or annotated
+};
+
+/// Matches one image's estimates to its ground truth, object by object (see the top of this
+/// file); equal scores keep the estimates' order. Throws InputError when an estimate or an
+/// instance names an object without a model, an estimate's R is not a rotation, or its score or
+/// t is not finite.
+ImageEvaluation evaluateImage(const std::vector<PoseEstimate>& estimates, const std::vector<GroundTruthPose>& gt,
+                              const std::map<int, EvalModel>& models, const EvalParams& params = {});
+
+struct ObjectScores {
+  double precision = 0, recall = 0, f1 = 0;  ///< 0 where the ratio is 0/0
+  int tp = 0, fp = 0, fn = 0;
+};
+
+ObjectScores scoresOf(const EvalCounts& counts);
+
+struct EvalSummary {
+  std::map<int, ObjectScores> objects;  ///< by obj_id
+  /// Precision, recall and F1 averaged over the objects (macro average; F1 is the mean of the
+  /// objects' F1, not the F1 of the means); tp, fp, fn summed.
+  ObjectScores mean;
+  /// Precision, recall and F1 of the summed counts (micro average).
+  ObjectScores total;
+};
+
+EvalSummary summarize(const std::map<int, EvalCounts>& counts);
+
+/// One row of a BOP results file.
+struct BopResult {
+  int scene_id = 0, im_id = 0;
+  PoseEstimate estimate;
+  double time_s = -1;  ///< the image's run time, seconds; -1: unknown
+};
+
+/// Writes bop_toolkit's results CSV: the header `scene_id,im_id,obj_id,score,R,t,time`, then one
+/// line per estimate with R as 9 row-major numbers and t as 3 numbers in millimetres, each
+/// separated by spaces. Numbers are written so that loadBopResults reads back the same floats.
+void saveBopResults(const std::string& path, const std::vector<BopResult>& results);
+
+/// Reads that CSV (the header line is optional, blank lines are skipped). Throws InputError with
+/// the file and line for a wrong number of columns, a value that is not a finite number, a
+/// negative id, or an R that is not a rotation.
+std::vector<BopResult> loadBopResults(const std::string& path);
+
+/// Scores results over every image of a dataset's split: images without results count their
+/// instances as false negatives. Throws InputError for a result whose image is not in the
+/// dataset.
+EvalSummary evaluateDataset(const BopDataset& dataset, const std::map<int, EvalModel>& models,
+                            const std::vector<BopResult>& results, const EvalParams& params = {});
+
+// ---- writing BOP files -----------------------------------------------------------------
+
+/// A continuous rotational symmetry of a model (BOP's symmetries_continuous): the axis and a
+/// point on it, object frame.
+struct ContinuousSymmetry {
+  Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();
+  Eigen::Vector3f offset_m = Eigen::Vector3f::Zero();
+};
+
+/// One model of a dataset: its mesh (metres) and symmetries.
+struct BopModel {
+  int obj_id = 0;
+  const Mesh* mesh = nullptr;
+  std::vector<ContinuousSymmetry> symmetries;
+};
+
+/// Writes the mesh in millimetres as a binary little-endian PLY (x y z, nx ny nz, and red
+/// green blue when it has colours; faces as uchar-counted int lists), what BOP's models/ hold.
+/// InputError when the file exists and `overwrite` is false, or it cannot be written.
+void writePlyMillimetres(const Mesh& mesh, const std::string& path, bool overwrite);
+
+/// models_info.json: diameter, min_x.. and size_x.. in mm, and symmetries_continuous where
+/// the model has any.
+std::string modelsInfoJson(const std::vector<BopModel>& models);
+
+/// camera.json: cx, cy, depth_scale, fx, fy, height, width.
+std::string cameraJson(const Camera& camera);
+
+/// scene_camera.json: per image cam_K (row-major 3x3) and depth_scale.
+std::string sceneCameraJson(const std::map<int, Camera>& cameras);
+
+/// scene_gt.json: per image the instances' cam_R_m2c (row-major), cam_t_m2c (mm) and obj_id.
+std::string sceneGtJson(const std::map<int, std::vector<GroundTruthPose>>& gt);
+
+/// scene_gt_info.json: per image the instances' bbox_obj, bbox_visib, px_count_all,
+/// px_count_valid, px_count_visib and visib_fract.
+std::string sceneGtInfoJson(const std::map<int, std::vector<GroundTruthInfo>>& info);
+
+// ---- the baselines' parameters --------------------------------------------------------
+
+struct LinemodBaselineParams {
+  MatchParams match;  ///< the similarity threshold, as the detector's stage 2
+  /// Move each match's template along its viewing ray by the mean difference between the
+  /// scene depth and the template's rendered depth (the cluster score's depth offset, one
+  /// GPU submit for all matches). Off: the pose sits at the template's training distance,
+  /// which is up to half a radius step away from the instance.
+  bool depth_offset = true;
+  /// Detections kept per object (bank) and image: the best by similarity. An 8-object LM-O
+  /// frame gives 1.09 M raw matches, whose one-to-one scoring would not finish; 0 keeps all.
+  int max_per_object = 100;
+};
+
+/// Distances relative to the object's diameter follow OpenCV's conventions; absolute ones are
+/// in metres. OpenCV's PPF pairs every scene reference point with every sampled scene point
+/// and its training walks whole hash chains, so time grows with the square of the sampled
+/// points on both sides; the defaults are what ran in seconds per object on a 640x480 LM-O
+/// frame on 2 cores and still found its driller (docs/evaluation.md).
+struct PpfParams {
+  /// Model sampling and PPF distance step, fraction of the model's bounding-box diagonal
+  /// (OpenCV's relativeSamplingStep). OpenCV divides each axis of the box into 1 / step cells,
+  /// so 0.1 keeps about 300 points of an LM-O object (spacing about 0.06 of its diameter);
+  /// 0.05 keeps about 1,400 and trains for minutes.
+  float model_step = 0.1f;
+  int angle_bins = 30;  ///< PPF angle quantization (OpenCV's numAngles; Drost et al.: 30)
+  int model_samples = 20000;  ///< points sampled on the mesh surface before OpenCV's own sampling
+  /// Scene sampling cell, fraction of the model's diameter (Drost et al.: 0.05); OpenCV
+  /// quantizes the scene's box in equal numbers of cells per axis, at most `max_scene_cells`
+  /// per axis, so a scene deeper or wider than max_scene_cells cells gets coarser ones.
+  float scene_step = 0.05f;
+  int max_scene_cells = 150;
+  float scene_ref_fraction = 0.1f;  ///< share of the sampled scene points used as reference points
+  /// Voted poses closer than these (fraction of the diameter; rotation angle, degrees) join one
+  /// cluster, whose votes add up (Drost et al.'s pose clustering).
+  float cluster_distance = 0.1f;
+  float cluster_angle_deg = 12.f;
+  int pixel_step = 2;               ///< back-project every n-th pixel of the depth image
+  int normal_step_px = 2;           ///< scene normals from depth differences this far either side
+  float normal_max_jump_m = 0.01f;  ///< ... not across a depth edge larger than this
+  /// ICP (OpenCV's point-to-plane ICP with robust rejection) on this many best-voted poses.
+  int icp_poses = 10;
+  int icp_iterations = 50;
+  int icp_levels = 4;
+  int icp_model_points = 1000;  ///< model points ICP aligns (a uniform subset of the samples)
+  /// Scene points farther than this many diameters from the pose's centre are left out of its
+  /// ICP (the object's neighbourhood, not the whole room).
+  float icp_crop = 0.75f;
+  /// Poses reported per object and image: the best-voted after ICP, dropping any whose centre
+  /// lies within `duplicate_distance` diameters of a better one's (one instance, two poses).
+  /// 3: the most instances of an object in a Tejani et al. scene.
+  int max_poses = 3;
+  float duplicate_distance = 0.25f;
+};
+/// Throws InputError naming the bad value.
+void validatePpfParams(const PpfParams& params);
+
+// ---- methods side by side -------------------------------------------------------------
 
 enum class EvalMethod { Vkpose, Linemod, Ppf };
 

@@ -1,20 +1,74 @@
 #pragma once
-// Synthetic multi-instance RGB-D datasets in BOP format (issue 6, `vkpose synth`): meshes at
-// poses from Tejani et al.'s pose files or at random physically plausible placements, with a
-// table, clutter that is not in the ground truth, lighting variation and a structured-light
-// sensor's noise. The same parameters and seed give byte-identical files.
+// Synthetic multi-instance RGB-D datasets in BOP format (`vkpose synth`): meshes at poses from
+// Tejani et al.'s pose files or at random physically plausible placements on a table or in a
+// bin, with clutter that is not in the ground truth, lighting variation and a structured-light
+// sensor's noise; the same parameters and seed give byte-identical files. And `vkpose demo`:
+// the whole pipeline on three objects built in code, piled in synthetic bins.
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/gpu_context.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/placement.hpp"
-#include "vkpose/scene.hpp"
+#include <Eigen/Core>
+
+#include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
+
+// ---- the sensor and the layout ---------------------------------------------------------
+
+/// Structured-light depth noise: axial Gaussian noise growing with distance squared,
+/// quantization, dropouts at depth edges and at grazing angles, and random holes (dark or
+/// shiny patches the projector's pattern does not come back from). Grazing dropouts and holes
+/// are off by default, which keeps the frames of callers that predate them as they were.
+struct DepthNoiseParams {
+  float axial_sigma_at_1m = 0.0015f;  ///< metres at 1 m; sigma(z) = this * z^2 (Kinect-like)
+  float quantization_m = 0.001f;      ///< the sensor's depth step (16-bit PNG in mm)
+  float edge_jump_m = 0.02f;          ///< a neighbour this much nearer or farther marks an edge
+  float edge_dropout = 0.5f;          ///< chance that an edge pixel reads nothing
+  float colour_sigma = 3.f;           ///< Gaussian noise on each colour channel, grey levels
+  /// Surfaces seen more obliquely than this (angle between normal and viewing ray) start to
+  /// lose readings; the chance grows linearly to grazing_dropout at 90 degrees.
+  float grazing_start_deg = 70.f;
+  float grazing_dropout = 0.f;        ///< chance of no reading at 90 degrees (0: off)
+  int holes = 0;                      ///< random elliptic holes per frame (0: off)
+  float hole_radius_px[2] = {3.f, 12.f};  ///< smallest and largest hole semi-axis, pixels
+  float max_range_m = 0.f;            ///< readings farther than this are lost (0: no limit)
+};
+
+enum class Layout { Table, Bin };
+
+struct PlacementParams {
+  Layout layout = Layout::Table;
+  Eigen::Vector2f bin_inner_m{0.40f, 0.30f};  ///< inside of the bin along world x and y, centred at the origin
+  float bin_wall_height_m = 0.15f;            ///< above the bin's floor (z = 0)
+  float bin_wall_thickness_m = 0.01f;
+  float gap_m = 0.002f;          ///< smallest clearance between two boxes
+  float image_margin = 0.1f;     ///< table: objects stand this share of the image inside its border
+  int tries = 200;               ///< positions tried per object before leaving it out
+  float drop_step_m = 0.002f;    ///< bin: height step of the drop-and-settle search
+  float bin_max_tilt_deg = 35.f; ///< bin: resting orientations tipped by up to this much
+  float max_pile_m = 0.2f;       ///< bin: an object whose bottom settles higher than this is left out
+  /// Only the resting orientation the mesh is modelled in (+z up), when it is stable: parts
+  /// that were stacked standing (a tray of cups) rather than tipped out of a box.
+  bool upright_only = false;
+};
+
+/// Where the camera may be: height of its centre above the table and tilt of its optical axis
+/// from the vertical (a camera over a workcell: 0.6 to 1.2 m, tilted up to 35 degrees).
+struct CameraRange {
+  float min_height_m = 0.6f, max_height_m = 1.2f;
+  float max_tilt_deg = 35.f;
+  float max_roll_deg = 10.f;  ///< turn about the optical axis either way
+  float target_jitter_m = 0.05f;  ///< the point looked at is this far from the origin at most
+};
+
+// ---- datasets -------------------------------------------------------------------------
 
 /// The PrimeSense camera of Tejani et al.'s sequences, whose poses the shared data holds.
 Camera tejaniCamera();
@@ -82,5 +136,71 @@ struct SynthImage {
 };
 SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
                            int index);
+
+// ---- the demo -------------------------------------------------------------------------
+
+struct DemoParams {
+  std::string out_dir = "vkpose-demo";
+  bool overwrite = false;  ///< replace out_dir's contents even when no earlier demo wrote it
+  std::string cache_dir;   ///< where banks are cached; empty: no cache
+  int images = 3;          ///< bin scenes
+  uint32_t seed = 1;
+  int min_instances = 2, max_instances = 2;  ///< of each object per scene
+  /// Training views: the upper hemisphere's viewpoints within max_view_angle_deg of the top
+  /// (the parts stand in the bin and the camera looks down), every in-plane turn.
+  ViewSamplingParams views{216, false, {0.55f, 0.85f, 0.1f}, {-180.f, 170.f, 10.f}};
+  float max_view_angle_deg = 40.f;
+  DetectorParams detector;
+};
+
+/// InputError for parameters out of range (images < 1 or > 100, bad instance counts, ...).
+void validateDemoParams(const DemoParams& params);
+
+/// What each step reports as it goes, for the command line to print; every member may be empty.
+struct DemoCallbacks {
+  std::function<void(const std::string&)> step;                 ///< a step starts: "Training lidded_cup"
+  std::function<void(std::size_t, std::size_t)> progress;       ///< within the step: (done, total)
+  std::function<void(const std::string&)> info;                 ///< a line of detail
+};
+
+struct DemoObject {
+  int obj_id = 0;
+  std::string name, mesh_path, bank_path;
+  std::size_t templates = 0;
+  bool bank_from_cache = false;
+  double train_s = 0;  ///< training (or reading the cached bank), seconds
+};
+
+struct DemoImageResult {
+  int image_id = 0;
+  std::string overlay_path, json_path;
+  DetectionResult result;
+};
+
+struct DemoReport {
+  std::string device;
+  std::vector<DemoObject> objects;
+  std::vector<DemoImageResult> images;
+  EvalReport evaluation;
+  int instances = 0;  ///< ground-truth instances in all scenes
+  double synth_s = 0, train_s = 0, detect_s = 0, total_s = 0;
+  std::string overlay_path, json_path, report_path;  ///< the first image's overlay and JSON, the score report
+};
+
+/// Runs the demo into params.out_dir: meshes/ (the objects, PLY), dataset/ (the bin scenes in
+/// BOP format), overlays/ and detections/ (per image), overlay.png and detections.json (the
+/// first image's, for a quick look), report.json (the scores) and results_vkpose.csv (BOP).
+/// An out_dir that exists, is not empty and was not written by an earlier demo is an
+/// InputError unless params.overwrite.
+DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallbacks& callbacks = {});
+
+/// The demo's three objects (a lidded cup, a gable-top carton, an angle bracket with a hole),
+/// built in code, metres, with vertex colours.
+std::vector<Mesh> demoMeshes();
+
+/// Writes demoMeshes() into `dir` (created if need be) as NAME.ply in millimetres, as the demo
+/// and assets/meshes/ hold them; returns the paths. InputError when a file exists and
+/// `overwrite` is false.
+std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite);
 
 }  // namespace vkpose

@@ -6,13 +6,16 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_support.hpp"
 #include "bench/detect_benchmark.hpp"
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
-#include "vkpose/detection_io.hpp"
+#include "util/progress.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
   auto* sub = bench.add_subcommand(
@@ -58,7 +61,7 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
     bar.reset();
     for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
     fmt::print("{}", bench::formatDetectReport(report));
-    printKernelProfile();
+    bench::printKernelProfile();
     if (!json_path->empty()) {
       writeTextFile(*json_path, bench::detectReportJson(report).dump(2) + "\n", false);
       if (!global.quiet) fmt::print("wrote {}\n", *json_path);

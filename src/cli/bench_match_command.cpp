@@ -9,16 +9,9 @@
 #include "bench/bench_support.hpp"
 #include "bench/match_benchmark.hpp"
 #include "cli/commands.hpp"
-#include "gpu/batch.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose::cli {
-
-void printKernelProfile() {
-  if (gpu::kernelProfile().empty()) return;
-  fmt::print("\nper kernel, all runs (VKPOSE_PROFILE_KERNELS; a submit per dispatch, so slower than a frame):\n");
-  for (const auto& [name, ms] : gpu::kernelProfile()) fmt::print("  {:<24} {:10.2f} ms\n", name, ms);
-}
 
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
@@ -127,7 +120,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
     }
     fmt::print("(passes: similarity passes, /submits when some overflowed and ran again; GPU peak: our GPU buffers at "
                "most at once; RSS: resident after vkpose's runs; peak RSS: the process so far)\n");
-    printKernelProfile();
+    bench::printKernelProfile();
     if (!json_path->empty()) {
       std::ofstream f(*json_path);
       if (!f) throw InputError("cannot write '" + *json_path + "'");

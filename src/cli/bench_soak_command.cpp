@@ -15,7 +15,7 @@
 #include "cli/commands.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
 
 namespace vkpose::cli {
 

@@ -6,11 +6,11 @@
 #include <CLI/CLI.hpp>
 
 #include "vkpose/detector.hpp"
-#include "vkpose/gpu_context.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose::cli {
 
-/// Exit codes, documented in README.md.
+/// Exit codes, documented in README.md and docs/reliability.md.
 enum ExitCode { kOk = 0, kBadInput = 1, kUsage = 2, kNoDevice = 3 };
 
 struct GlobalOptions {
@@ -44,7 +44,5 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 /// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.
 Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global);
 void addBenchSoakCommand(CLI::App& bench, const GlobalOptions& global);  ///< `vkpose bench soak`
-/// With VKPOSE_PROFILE_KERNELS set: the milliseconds per kernel the run's dispatches took.
-void printKernelProfile();
 
 }  // namespace vkpose::cli

@@ -5,16 +5,18 @@
 
 #include "bench/bench_support.hpp"
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
-#include "vkpose/bank_cache.hpp"
-#include "vkpose/demo.hpp"
+#include "util/progress.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/synth.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 namespace {
 struct DemoOptions {
   DemoParams params;
-  std::string cache = defaultBankCacheDir(), config;
+  std::string cache = defaultBankCacheDir(), config, write_meshes;
   bool no_cache = false;
 };
 
@@ -64,7 +66,15 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-cache", opt->no_cache, "Train the banks again and do not keep them");
   addConfigOption(sub, opt->config);
   sub->add_flag("--force", p.overwrite, "Replace the demo's outputs in --out even if that folder holds other things");
+  sub->add_option("--write-meshes", opt->write_meshes,
+                  "Only write the three objects as PLY (millimetres) into this folder and stop (assets/meshes is "
+                  "made so); --force replaces files there");
   return [opt, &global]() {
+    if (!opt->write_meshes.empty()) {
+      for (const std::string& path : writeDemoMeshes(opt->write_meshes, opt->params.overwrite))
+        if (!global.quiet) fmt::print("wrote {}\n", path);
+      return 0;
+    }
     DemoParams params = opt->params;
     params.cache_dir = opt->no_cache ? "" : opt->cache;
     params.detector = withConfig(opt->config, params.detector);

@@ -7,13 +7,14 @@
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
-#include "vkpose/detection_io.hpp"
+#include "util/progress.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 namespace {
 struct DetectOptions {

@@ -7,12 +7,14 @@
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
-#include "vkpose/detection_io.hpp"
+#include "util/progress.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 namespace {
 struct EvalOptions {

@@ -3,8 +3,8 @@
 #include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/template_bank.hpp"
 
 namespace vkpose::cli {
 

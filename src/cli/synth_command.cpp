@@ -5,11 +5,13 @@
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
+#include "util/progress.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 namespace {
 struct SynthOptions {

@@ -4,12 +4,15 @@
 
 #include <fmt/core.h>
 
+#include "bench/bench_support.hpp"
 #include "cli/commands.hpp"
-#include "cli/progress.hpp"
+#include "util/progress.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/template_bank.hpp"
 
 namespace vkpose::cli {
+
+using util::ProgressBar;
 
 namespace {
 struct TrainOptions {
@@ -95,7 +98,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                  1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
       fmt::print("bank: {} ({:.1f} MiB)\n", opt->out, static_cast<double>(bytes) / (1 << 20));
     }
-    printKernelProfile();
+    bench::printKernelProfile();
     return kOk;
   };
 }

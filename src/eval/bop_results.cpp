@@ -12,7 +12,7 @@
 
 #include "eval/checks.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
 
 namespace vkpose {
 namespace {

@@ -11,8 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include "eval/checks.hpp"
-#include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

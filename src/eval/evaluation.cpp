@@ -9,10 +9,16 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "eval/baselines.hpp"
+#include "hypotheses/cluster_score.hpp"
 #include "util/timing.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -4,9 +4,18 @@
 
 #include <fmt/format.h>
 
+#include "eval/baselines.hpp"
+#include "hypotheses/cluster_score.hpp"
+#include "hypotheses/hypotheses.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "pipeline/pipeline.hpp"
 #include "util/timing.hpp"
-#include "vkpose/baselines.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -1,5 +1,5 @@
-// One-to-one matching of estimates to ground truth and precision / recall / F1 (DESIGN.md
-// "Evaluation protocol").
+// One-to-one matching of estimates to ground truth and precision / recall / F1 (docs/evaluation.md,
+// "The protocol").
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -8,8 +8,8 @@
 
 #include "eval/checks.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

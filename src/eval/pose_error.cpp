@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "vkpose/metrics.hpp"
+#include "vkpose/evaluation.hpp"
 
 namespace vkpose {
 namespace {

@@ -11,10 +11,14 @@
 #include <opencv2/surface_matching.hpp>
 #include <opencv2/surface_matching/ppf_helpers.hpp>
 
+#include "eval/baselines.hpp"
+#include "hypotheses/cluster_score.hpp"
 #include "hypotheses/cluster_score_math.hpp"
+#include "match/matcher.hpp"
 #include "util/timing.hpp"
-#include "vkpose/baselines.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

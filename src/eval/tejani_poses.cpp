@@ -8,8 +8,9 @@
 #include <fmt/format.h>
 
 #include "eval/checks.hpp"
-#include "vkpose/dataset.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace {

@@ -1,4 +1,4 @@
-// Vulkan instance, device choice and compute queue (DESIGN.md "GPU layer").
+// Vulkan instance, device choice and compute queue (docs/pipeline.md, "The GPU layer").
 #include <atomic>
 #include <cstdlib>
 #include <cstring>

@@ -5,7 +5,7 @@
 
 #include <atomic>
 
-#include "vkpose/gpu_context.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose::gpu {
 

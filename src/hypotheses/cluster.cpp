@@ -6,8 +6,11 @@
 
 #include <Eigen/Geometry>
 
+#include "hypotheses/hypotheses.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/hypotheses.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "vkpose/cluster_score.hpp"
+#include "hypotheses/cluster_score.hpp"
 
 namespace vkpose::score {
 

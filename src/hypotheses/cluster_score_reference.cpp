@@ -8,21 +8,6 @@
 
 namespace vkpose {
 
-void validateScoreParams(const ScoreParams& p) {
-  auto positive = [](float v, const char* name) {
-    if (!(v > 0.f) || !std::isfinite(v)) throw InputError(std::string("cluster score: ") + name + " must be positive");
-  };
-  positive(p.depth_unit_m, "depth unit");
-  positive(p.depth_cap_m, "depth cap");
-  positive(p.angle_unit_rad, "angle unit");
-  positive(p.normal_max_jump_m, "normal depth jump");
-  if (p.normal_step_px < 1 || p.normal_step_px > 16) throw InputError("cluster score: normal step must be 1..16 pixels");
-  if (!(p.min_valid_fraction >= 0.f && p.min_valid_fraction <= 1.f))
-    throw InputError("cluster score: minimum valid fraction must be in [0, 1]");
-  if (p.top_members < 1) throw InputError("cluster score: top members must be at least 1");
-  if (p.max_members < 0) throw InputError("cluster score: max members must be >= 0 (0: all)");
-}
-
 ScoreScene makeScoreScene(const cv::Mat& depth_mm, const Camera& camera) {
   if (depth_mm.empty() || depth_mm.type() != CV_16UC1)
     throw InputError("cluster score: the depth image must be 16-bit millimetres");

@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "vkpose/camera.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -5,7 +5,7 @@
 
 #include "io/image_file.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/frame_io.hpp"
+#include "vkpose/frame.hpp"
 
 namespace vkpose {
 

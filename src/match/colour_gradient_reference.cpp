@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "match/border.hpp"
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose {
 namespace {

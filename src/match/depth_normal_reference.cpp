@@ -4,7 +4,7 @@
 #include <cstdlib>
 
 #include "match/border.hpp"
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose {
 

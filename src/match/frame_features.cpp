@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include "match/features.hpp"
 #include "match/match_geometry.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/features.hpp"
 
 namespace vkpose {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "gpu/batch.hpp"
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose::gpu {
 

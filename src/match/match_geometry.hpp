@@ -3,9 +3,9 @@
 // drift apart: position offsets, thresholds, refinement windows and memory layouts.
 #include <vector>
 
-#include "vkpose/features.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/templates.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose::match {
 

@@ -4,10 +4,12 @@
 #include <chrono>
 
 #include "match/frame_features_gpu.hpp"
+#include "match/matcher.hpp"
 #include "match/similarity_gpu.hpp"
 #include "util/timing.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/matcher.hpp"
 
 namespace vkpose {
 

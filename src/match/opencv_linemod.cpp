@@ -1,8 +1,11 @@
-#include "vkpose/opencv_linemod.hpp"
+#include "match/opencv_linemod.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose {

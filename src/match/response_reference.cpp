@@ -2,7 +2,7 @@
 // shaders/response_linearize.comp computes the same bytes.
 #include <algorithm>
 
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose {
 

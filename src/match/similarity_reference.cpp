@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <tuple>
 
+#include "match/features.hpp"
 #include "match/match_geometry.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/matcher.hpp"
 
 namespace vkpose {
 

@@ -1,5 +1,5 @@
 // Spreading, CPU reference (LINEMOD section 2.3). shaders/spread.comp computes the same bits.
-#include "vkpose/features.hpp"
+#include "match/features.hpp"
 
 namespace vkpose {
 

@@ -1,7 +1,7 @@
 #include <string>
 
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/templates.hpp"
 
 namespace vkpose {
 

@@ -9,6 +9,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "hypotheses/cluster_score.hpp"
+#include "match/matcher.hpp"
+#include "render/render.hpp"
+#include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose {

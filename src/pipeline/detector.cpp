@@ -5,10 +5,22 @@
 
 #include <fmt/format.h>
 
+#include "hypotheses/cluster_score.hpp"
+#include "hypotheses/hypotheses.hpp"
+#include "match/matcher.hpp"
+#include "pipeline/pipeline.hpp"
+#include "pose/initial_pose.hpp"
+#include "pose/point_cloud.hpp"
+#include "pose/refine.hpp"
+#include "pose/verify.hpp"
+#include "render/render.hpp"
 #include "util/parallel.hpp"
 #include "util/timing.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 
@@ -77,26 +89,6 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 }
 
 Detector::~Detector() = default;
-
-void validateDetectorParams(const DetectorParams& p) {
-  if (!(p.match.threshold > 0.f && p.match.threshold <= 100.f))
-    throw InputError(fmt::format("the match threshold must be in (0, 100] percent, not {}", p.match.threshold));
-  if (p.cluster.position_step_px < 1 || p.cluster.min_templates < 1)
-    throw InputError(fmt::format("the clustering cell ({} px) and the smallest cluster ({} templates) must be 1 or more",
-                                 p.cluster.position_step_px, p.cluster.min_templates));
-  if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f))
-    throw InputError("the NMS radius must be 0 or more pixels and its fraction more than 0");
-  validateScoreParams(p.score);
-  if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
-  if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");
-  if (p.pose_candidates_per_object < 1)
-    throw InputError(fmt::format("pose candidates per object must be at least 1, not {}", p.pose_candidates_per_object));
-  validateInitialPoseParams(p.initial_pose);
-  validateRefineParams(p.refine);
-  validateVerifyParams(p.verify);
-  if (!(p.duplicate_fraction >= 0.f && p.duplicate_fraction <= 10.f))
-    throw InputError(fmt::format("the duplicate distance must be in [0, 10] diameters, not {}", p.duplicate_fraction));
-}
 
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera) {

@@ -8,20 +8,15 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
+#include "hypotheses/hypotheses.hpp"
+#include "match/matcher.hpp"
+#include "pose/initial_pose.hpp"
+#include "render/render.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/initial_pose.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
-
-void validateInitialPoseParams(const InitialPoseParams& p) {
-  if (!(p.rotation_cluster_deg > 0.f && p.rotation_cluster_deg <= 180.f))
-    throw InputError(fmt::format("the rotation cluster angle must be in (0, 180] degrees, not {}",
-                                 p.rotation_cluster_deg));
-  if (!(p.depth_band_fraction > 0.f && p.depth_band_fraction <= 10.f))
-    throw InputError(fmt::format("the depth band must be in (0, 10] diameters, not {}", p.depth_band_fraction));
-  if (!(p.crop_margin_fraction >= 0.f && p.crop_margin_fraction <= 10.f))
-    throw InputError(fmt::format("the crop margin must be in [0, 10] object sizes, not {}", p.crop_margin_fraction));
-}
 
 float rotationDistance(const Eigen::Matrix3f& a, const Eigen::Matrix3f& b) {
   // trace(A^T B) = 1 + 2 cos(angle); clamped against rounding just outside [-1, 1].

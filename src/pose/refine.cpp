@@ -1,6 +1,6 @@
-// Pose refinement with PCL (DESIGN.md stage 7): MLS smoothing, voxel grid, adaptive ICP.
+// Pose refinement with PCL (docs/pipeline.md, stage 7): MLS smoothing, voxel grid, adaptive ICP.
 // The only translation unit that includes PCL headers (about 10 s to compile).
-#include "vkpose/refine.hpp"
+#include "pose/refine.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -11,7 +11,11 @@
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 
-// GCC 12 reports false -Warray-bounds from inside Eigen/PCL templates (MEASURED.md); the
+#include "pose/point_cloud.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/geometry.hpp"
+
+// GCC 12 reports false -Warray-bounds from inside Eigen/PCL templates (docs/measured.md); the
 // file's build options silence it for this translation unit only (CMakeLists.txt).
 #include <pcl/common/transforms.h>
 #include <pcl/filters/voxel_grid.h>
@@ -103,22 +107,6 @@ void checkMls(float radius, int order, float seed_voxel) {
 }
 
 }  // namespace
-
-void validateRefineParams(const RefineParams& p) {
-  if (p.mls) checkMls(p.mls_radius, p.mls_polynomial_order, 0.f);
-  if (!std::isfinite(p.voxel_size) || p.voxel_size < 0.f)
-    throw InputError(fmt::format("voxel size must be >= 0 and finite, got {}", p.voxel_size));
-  for (float f : {p.coarse_fraction, p.fine_fraction})
-    if (!(f > 0.f && f <= 1.f)) throw InputError(fmt::format("ICP threshold fractions must lie in (0, 1], got {}", f));
-  if (p.coarse_iterations < 0 || p.fine_iterations < 0)
-    throw InputError(fmt::format("ICP iteration limits must be >= 0, got {} and {}", p.coarse_iterations,
-                                 p.fine_iterations));
-  if (!(p.convergence_epsilon >= 0.0))
-    throw InputError(fmt::format("ICP convergence epsilon must be >= 0, got {}", p.convergence_epsilon));
-  if (!std::isfinite(p.fixed_max_correspondence_m) || p.fixed_max_correspondence_m < 0.f)
-    throw InputError(fmt::format("fixed max correspondence distance must be >= 0, got {}",
-                                 p.fixed_max_correspondence_m));
-}
 
 namespace {
 

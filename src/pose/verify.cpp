@@ -1,6 +1,6 @@
-// Pose verification with OctoMap (DESIGN.md stage 8): the collision rate of the posed model's
+// Pose verification with OctoMap (docs/pipeline.md, stage 8): the collision rate of the posed model's
 // visible points against an octree of the scene points.
-#include "vkpose/verify.hpp"
+#include "pose/verify.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -10,26 +10,12 @@
 #include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
 
+#include "pose/point_cloud.hpp"
+#include "render/render.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
-
-void validateVerifyParams(const VerifyParams& params) {
-  if (!(params.resolution > 0.f) || !std::isfinite(params.resolution))
-    throw InputError(fmt::format("octree resolution must be positive and finite, got {}", params.resolution));
-  if (!(params.crop_margin >= 0.f) || !std::isfinite(params.crop_margin))
-    throw InputError(fmt::format("verification crop margin must be >= 0 and finite, got {}", params.crop_margin));
-  if (!std::isfinite(params.threshold))
-    throw InputError(fmt::format("collision rate threshold must be finite, got {}", params.threshold));
-  if (!(params.see_through_tolerance >= 0.f) || !std::isfinite(params.see_through_tolerance))
-    throw InputError(fmt::format("see-through tolerance must be >= 0 metres, got {}", params.see_through_tolerance));
-  if (!(params.max_see_through >= 0.f && params.max_see_through <= 1.f))
-    throw InputError(fmt::format("the largest see-through share must be in [0, 1], got {}", params.max_see_through));
-  if (!(params.silhouette_jump > 0.f) || !std::isfinite(params.silhouette_jump))
-    throw InputError(fmt::format("the silhouette step must be > 0 metres, got {}", params.silhouette_jump));
-  if (!(params.min_silhouette_support >= 0.f && params.min_silhouette_support <= 1.f))
-    throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
-}
 
 namespace {
 /// The scene depth at the pixel nearest to (x, y); 0 outside the image or where there is none.

@@ -1,5 +1,3 @@
-#include "vkpose/mesh.hpp"
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -18,6 +16,7 @@
 #include <fmt/ranges.h>
 
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 // assimp 5.2 as Debian builds it keeps its internal checks (ai_assert) on, and their handler
 // aborts the process: a PLY whose face list does not match its header reaches one in the

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/render.hpp"
+#include "vkpose/geometry.hpp"
+#include "render/render.hpp"
 
 namespace vkpose::render {
 

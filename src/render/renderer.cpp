@@ -9,8 +9,10 @@
 #include "gpu/buffer.hpp"
 #include "gpu/kernel.hpp"
 #include "render/raster_math.hpp"
+#include "render/render.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/render.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

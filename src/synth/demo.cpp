@@ -1,18 +1,21 @@
 // `vkpose demo` (demo.hpp): procedural objects piled in a bin, trained, detected and scored.
-#include "vkpose/demo.hpp"
+#include "vkpose/synth.hpp"
 
 #include <chrono>
 #include <filesystem>
 
 #include <fmt/format.h>
 
+#include "eval/baselines.hpp"
+#include "match/matcher.hpp"
+#include "render/render.hpp"
 #include "util/timing.hpp"
-#include "vkpose/bank_cache.hpp"
-#include "vkpose/bop_writer.hpp"
-#include "vkpose/detection_io.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/procedural_meshes.hpp"
-#include "vkpose/synth.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 
@@ -80,6 +83,16 @@ void validateDemoParams(const DemoParams& params) {
   validateDetectorParams(params.detector);
 }
 
+std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite) {
+  fs::create_directories(dir);
+  std::vector<std::string> paths;
+  for (const Mesh& mesh : demoMeshes()) {
+    paths.push_back((fs::path(dir) / (mesh.name + ".ply")).string());
+    writePlyMillimetres(mesh, paths.back(), overwrite);
+  }
+  return paths;
+}
+
 DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallbacks& callbacks) {
   validateDemoParams(params);
   const auto t_start = std::chrono::steady_clock::now();
@@ -95,13 +108,7 @@ DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallback
   const fs::path out(params.out_dir);
 
   // 1. The objects, built in code and written as PLY (millimetres) for the user to look at.
-  std::vector<std::string> mesh_paths;
-  fs::create_directories(out / "meshes");
-  for (const Mesh& mesh : demoMeshes()) {
-    const std::string path = (out / "meshes" / (mesh.name + ".ply")).string();
-    writePlyMillimetres(mesh, path, true);
-    mesh_paths.push_back(path);
-  }
+  const std::vector<std::string> mesh_paths = writeDemoMeshes((out / "meshes").string(), true);
 
   // 2. The bin scenes, in BOP format.
   step(fmt::format("Rendering {} bin scene{} with sensor noise", params.images, params.images == 1 ? "" : "s"));

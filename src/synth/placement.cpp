@@ -9,8 +9,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include "synth/placement.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/placement.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

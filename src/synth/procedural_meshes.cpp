@@ -1,13 +1,14 @@
 // The demo's objects, built from lathes, prisms, boxes and cylinders (procedural_meshes.hpp).
-#include "vkpose/procedural_meshes.hpp"
+#include "synth/procedural_meshes.hpp"
 
 #include <cmath>
 #include <numbers>
 
 #include <Eigen/Geometry>
 
+#include "synth/scene.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/scene.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 namespace procedural {

@@ -6,8 +6,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "render/render.hpp"
+#include "synth/scene.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/scene.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

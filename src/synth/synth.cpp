@@ -11,10 +11,13 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "vkpose/bop_writer.hpp"
-#include "vkpose/dataset.hpp"
-#include "vkpose/detection_io.hpp"
+#include "synth/placement.hpp"
+#include "synth/scene.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose {

@@ -1,5 +1,5 @@
 // Template banks cached between runs (bank_cache.hpp).
-#include "vkpose/bank_cache.hpp"
+#include "vkpose/bank.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -7,7 +7,9 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

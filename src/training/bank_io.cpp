@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
-#include "vkpose/bank_cache.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -7,10 +7,15 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include "match/features.hpp"
+#include "render/render.hpp"
+#include "training/training.hpp"
 #include "util/parallel.hpp"
 #include "util/timing.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -2,8 +2,9 @@
 // the GPU training itself (the fuzz build links the readers without the GPU layer).
 #include <fmt/format.h>
 
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

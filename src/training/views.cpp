@@ -1,4 +1,4 @@
-#include "vkpose/views.hpp"
+#include "vkpose/bank.hpp"
 
 #include <cmath>
 #include <numbers>

@@ -1,5 +1,5 @@
 #pragma once
-// Rendering a mesh with compute shaders (DESIGN.md stage 0: no OpenGL). Many views render
+// Rendering a mesh with compute shaders (docs/pipeline.md, stage 0: no OpenGL). Many views render
 // per submit; each gives depth, normals, mask and colour. renderReference is the plain C++
 // rasterizer the GPU kernels are tested against.
 #include <memory>
@@ -10,17 +10,10 @@
 #include <Eigen/LU>
 #include <opencv2/core.hpp>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/gpu_context.hpp"
-#include "vkpose/mesh.hpp"
+#include "vkpose/geometry.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose {
-
-/// Object-to-camera pose: x_cam = R x_obj + t (metres).
-struct Pose {
-  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
-  Eigen::Vector3f t = Eigen::Vector3f::Zero();
-};
 
 /// One rendered view. Pixel centres sit at integer coordinates (x = fx X / Z + cx).
 struct Rendering {

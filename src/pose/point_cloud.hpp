@@ -1,11 +1,11 @@
 #pragma once
-// A plain point cloud, the currency of the pose stages (DESIGN.md stages 6-8). No PCL or
+// A plain point cloud, the currency of the pose stages (docs/pipeline.md, stages 6-8). No PCL or
 // OctoMap type appears in a public header: those libraries stay inside src/pose/.
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "vkpose/render.hpp"  // Pose
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -1,5 +1,5 @@
 #pragma once
-// Stage 4 (DESIGN.md): the cluster score gamma = alpha * beta. Each template of a hypothesis
+// Stage 4 (docs/pipeline.md): the cluster score gamma = alpha * beta. Each template of a hypothesis
 // is laid on the scene at the hypothesis's centre; its stored depth and normal crop is
 // compared with the scene's depth and normals over the cells where both are valid:
 //   alpha = exp(-mean |depth difference - mean depth difference| / depth_unit)
@@ -9,7 +9,7 @@
 // shape, not about which radius.
 //
 // Choices, measured on synthetic cup scenes with milk-jug and carton clutter and Kinect-like
-// noise (8 scenes, 48 visible cups; see the note on issue 4):
+// noise (8 scenes, 48 visible cups; docs/pipeline.md, stage 4):
 // - Units: the paper's metres made alpha about 0.99 for everything (a few millimetres of
 //   error is exp(-0.003)). Here depth errors are in centimetres (depth_unit_m = 0.01) and
 //   angles in half radians, so a template that fits within 3 mm and 15 degrees scores about
@@ -23,31 +23,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/gpu_context.hpp"
-#include "vkpose/hypotheses.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/geometry.hpp"
+#include "vkpose/device.hpp"
+#include "hypotheses/hypotheses.hpp"
 
 namespace vkpose {
-
-struct ScoreParams {
-  float depth_unit_m = 0.01f;      ///< alpha's unit: alpha = exp(-error / unit)
-  float depth_cap_m = 0.02f;       ///< per-cell depth errors are truncated here (occluders, background)
-  float angle_unit_rad = 0.5f;     ///< beta's unit: beta = exp(-mean angle / unit)
-  /// Scene normals: cross product of depth differences `normal_step_px` pixels either side;
-  /// a difference larger than `normal_max_jump_m` is a depth edge (no normal there).
-  int normal_step_px = 2;
-  float normal_max_jump_m = 0.01f;
-  /// A template must find scene depth on this share of its object cells, else it scores 0
-  /// (no evidence: a hole in the depth map, or the template hangs over the image border).
-  float min_valid_fraction = 0.5f;
-  /// Members scored per hypothesis, best similarity first (0: all).
-  int max_members = 32;
-  /// alpha and beta pool this many best-fitting members (missing ones count as misfits).
-  int top_members = 3;
-};
-
-/// Throws InputError naming the bad value.
-void validateScoreParams(const ScoreParams& params);
 
 /// The scene as the cluster score sees it.
 struct ScoreScene {

@@ -1,13 +1,18 @@
 #pragma once
-// Object meshes for training and rendering (DESIGN.md stage 0). Metres internally; the file's
-// unit is explicit or inferred from the object's size.
+// The geometry every stage shares: object meshes (loaded with assimp; metres internally, the
+// file's unit explicit or inferred from the object's size), object-to-camera poses, and pinhole
+// camera intrinsics (read from BOP-style camera files).
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace vkpose {
+
+// ---- meshes ----------------------------------------------------------------------------
 
 enum class MeshUnits { Auto, Millimetres, Metres };
 
@@ -53,5 +58,33 @@ float exactDiameter(const std::vector<Eigen::Vector3f>& points);
 
 /// FNV-1a 64-bit hash of bytes, used for mesh identity and bank checksums.
 uint64_t fnv1a64(const void* data, std::size_t size, uint64_t seed = 0xcbf29ce484222325ull);
+
+// ---- poses and cameras ----------------------------------------------------------------
+
+/// Object-to-camera pose: x_cam = R x_obj + t (metres).
+struct Pose {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();
+};
+
+struct Camera {
+  double fx = 572.4114, fy = 573.57043;  ///< focal lengths, pixels (default: the LINEMOD Kinect)
+  double cx = 325.2611, cy = 242.04899;  ///< principal point, pixels
+  int width = 640, height = 480;         ///< image size, pixels
+  double depth_scale = 1.0;              ///< millimetres per depth-PNG unit (BOP)
+
+  Eigen::Vector2f project(const Eigen::Vector3f& p) const {
+    return {static_cast<float>(fx * p.x() / p.z() + cx), static_cast<float>(fy * p.y() / p.z() + cy)};
+  }
+};
+
+/// Throws InputError when a focal length is not positive and finite, the principal point is
+/// not finite, the size is not 1..16384, or the depth scale is not positive.
+void validateCamera(const Camera& camera, const std::string& source = "camera");
+
+/// Reads a BOP camera.json ({"fx", "fy", "cx", "cy", "width", "height", "depth_scale"} or
+/// {"cam_K": [9 numbers], ...}) or one entry of a scene_camera.json (`entry`: its key; empty:
+/// the first entry). Throws InputError naming the file and the missing or bad field.
+Camera loadCamera(const std::string& path, const std::string& entry = "");
 
 }  // namespace vkpose

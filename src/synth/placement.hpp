@@ -11,9 +11,9 @@
 #include <random>
 #include <vector>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/mesh.hpp"
-#include "vkpose/render.hpp"
+#include "vkpose/synth.hpp"
+#include "vkpose/geometry.hpp"
+#include "render/render.hpp"
 
 namespace vkpose {
 
@@ -53,33 +53,6 @@ struct RestingOrientation {
 /// The stable resting orientations among the six bounding-box faces down (all six, weight 1,
 /// for a mesh none of whose faces is stable).
 std::vector<RestingOrientation> restingOrientations(const Mesh& mesh);
-
-enum class Layout { Table, Bin };
-
-struct PlacementParams {
-  Layout layout = Layout::Table;
-  Eigen::Vector2f bin_inner_m{0.40f, 0.30f};  ///< inside of the bin along world x and y, centred at the origin
-  float bin_wall_height_m = 0.15f;            ///< above the bin's floor (z = 0)
-  float bin_wall_thickness_m = 0.01f;
-  float gap_m = 0.002f;          ///< smallest clearance between two boxes
-  float image_margin = 0.1f;     ///< table: objects stand this share of the image inside its border
-  int tries = 200;               ///< positions tried per object before leaving it out
-  float drop_step_m = 0.002f;    ///< bin: height step of the drop-and-settle search
-  float bin_max_tilt_deg = 35.f; ///< bin: resting orientations tipped by up to this much
-  float max_pile_m = 0.2f;       ///< bin: an object whose bottom settles higher than this is left out
-  /// Only the resting orientation the mesh is modelled in (+z up), when it is stable: parts
-  /// that were stacked standing (a tray of cups) rather than tipped out of a box.
-  bool upright_only = false;
-};
-
-/// Where the camera may be: height of its centre above the table and tilt of its optical axis
-/// from the vertical (a camera over a workcell: 0.6 to 1.2 m, tilted up to 35 degrees).
-struct CameraRange {
-  float min_height_m = 0.6f, max_height_m = 1.2f;
-  float max_tilt_deg = 35.f;
-  float max_roll_deg = 10.f;  ///< turn about the optical axis either way
-  float target_jitter_m = 0.05f;  ///< the point looked at is this far from the origin at most
-};
 
 /// camera_T_world of a camera `height_m` above the table whose optical axis passes through
 /// `target` (on the table), tilted `tilt_rad` from the vertical, standing on the side of

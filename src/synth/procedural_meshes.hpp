@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "vkpose/mesh.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 
@@ -21,9 +21,6 @@ Mesh gableCartonMesh();
 /// A grey steel angle bracket: base plate, upright plate, a stiffening gusset and a boss
 /// (10 x 6 x 7 cm).
 Mesh angleBracketMesh();
-
-/// The three above, in that order.
-std::vector<Mesh> demoMeshes();
 
 /// Building blocks, exposed for tests.
 namespace procedural {

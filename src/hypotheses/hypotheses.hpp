@@ -1,5 +1,5 @@
 #pragma once
-// Stages 3 and 5 (DESIGN.md): LINEMOD's many overlapping matches become one hypothesis per
+// Stages 3 and 5 (docs/pipeline.md): LINEMOD's many overlapping matches become one hypothesis per
 // object instance. Clustering groups matches that put the same object's centre in the same
 // image cell at the same training distance; non-maximum suppression keeps, among hypotheses
 // that sit on one instance, the one with the best cluster score (stage 4, cluster_score.hpp).
@@ -8,8 +8,9 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "vkpose/matcher.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/config.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
 
@@ -25,14 +26,6 @@ struct TemplateIndex {
 
 /// The LINEMOD templates of all banks, concatenated as TemplateIndex numbers them.
 std::vector<LinemodTemplate> concatenateTemplates(const std::vector<TemplateBank>& banks);
-
-struct ClusterParams {
-  /// s_im: the object centres of matches are quantized into cells of this many pixels. The
-  /// paper used about 12; see the note on issue 4 for the measurement behind the default.
-  int position_step_px = 12;
-  /// tau_c: clusters of fewer distinct templates are noise (a lone template matching clutter).
-  int min_templates = 3;
-};
 
 /// One template of a hypothesis: the best of its matches in the cluster.
 struct ClusterMember {
@@ -71,15 +64,6 @@ struct Hypothesis {
 /// (bank, then cell, then distance).
 std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, const std::vector<TemplateBank>& banks,
                                          const ClusterParams& params = {});
-
-struct NmsParams {
-  /// r: a hypothesis is suppressed by a better one whose centre lies within this many
-  /// pixels. 0: per pair, `radius_fraction` of the larger projected object diameter.
-  float radius_px = 0.f;
-  float radius_fraction = 0.5f;
-  /// Suppress across objects too (one place in the image holds one object).
-  bool across_objects = true;
-};
 
 /// Stage 5: hypotheses sorted by score (best first), then each survives unless a better
 /// survivor's centre lies within the radius (centres stay where they are; nothing merges).

@@ -5,8 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "vkpose/features.hpp"
-#include "vkpose/render.hpp"
+#include "vkpose/synth.hpp"
+#include "match/features.hpp"
+#include "render/render.hpp"
 
 namespace vkpose {
 
@@ -59,25 +60,6 @@ struct Lighting {
 /// Replaces scene.bgr (albedo) by albedo * gain * (ambient + diffuse * n.l) + highlight, using
 /// scene.normals; pixels where nothing is stay as they are.
 void applyLighting(SceneRendering& scene, const Lighting& light);
-
-/// Structured-light depth noise: axial Gaussian noise growing with distance squared,
-/// quantization, dropouts at depth edges and at grazing angles, and random holes (dark or
-/// shiny patches the projector's pattern does not come back from). Grazing dropouts and holes
-/// are off by default, which keeps the frames of callers that predate them as they were.
-struct DepthNoiseParams {
-  float axial_sigma_at_1m = 0.0015f;  ///< metres at 1 m; sigma(z) = this * z^2 (Kinect-like)
-  float quantization_m = 0.001f;      ///< the sensor's depth step (16-bit PNG in mm)
-  float edge_jump_m = 0.02f;          ///< a neighbour this much nearer or farther marks an edge
-  float edge_dropout = 0.5f;          ///< chance that an edge pixel reads nothing
-  float colour_sigma = 3.f;           ///< Gaussian noise on each colour channel, grey levels
-  /// Surfaces seen more obliquely than this (angle between normal and viewing ray) start to
-  /// lose readings; the chance grows linearly to grazing_dropout at 90 degrees.
-  float grazing_start_deg = 70.f;
-  float grazing_dropout = 0.f;        ///< chance of no reading at 90 degrees (0: off)
-  int holes = 0;                      ///< random elliptic holes per frame (0: off)
-  float hole_radius_px[2] = {3.f, 12.f};  ///< smallest and largest hole semi-axis, pixels
-  float max_range_m = 0.f;            ///< readings farther than this are lost (0: no limit)
-};
 
 /// The frame a sensor would deliver (depth in millimetres, 0 = no reading); reproducible
 /// from `seed`. Grazing dropouts use scene.normals and scene.camera.

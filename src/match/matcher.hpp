@@ -7,17 +7,12 @@
 #include <memory>
 #include <vector>
 
-#include "vkpose/features.hpp"
-#include "vkpose/gpu_context.hpp"
-#include "vkpose/templates.hpp"
+#include "vkpose/config.hpp"
+#include "match/features.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
-
-struct MatchParams {
-  /// Similarity in percent a match needs; 0 % is what a random image gives (half the maximum
-  /// response per feature), 100 % a perfect match (OpenCV's convention).
-  float threshold = 80.0f;
-};
 
 /// A template found in a frame.
 struct Match {

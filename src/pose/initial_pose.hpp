@@ -1,5 +1,5 @@
 #pragma once
-// Initial pose (DESIGN.md stage 6; He, Rojas, Guan, section on the initial pose): the rotation
+// Initial pose (docs/pipeline.md, stage 6; He, Rojas, Guan, section on the initial pose): the rotation
 // is the mean of the largest group of mutually close template rotations of a hypothesis, each
 // turned onto its own viewing ray; the translation moves the model, rendered at that rotation,
 // by the difference between the centroid of the scene points under its mask and the centroid
@@ -12,33 +12,14 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "vkpose/camera.hpp"
-#include "vkpose/hypotheses.hpp"
-#include "vkpose/point_cloud.hpp"
-#include "vkpose/render.hpp"
-#include "vkpose/template_bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/geometry.hpp"
+#include "hypotheses/hypotheses.hpp"
+#include "pose/point_cloud.hpp"
+#include "render/render.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
-
-struct InitialPoseParams {
-  /// tau_theta: template rotations closer than this (axis-angle distance to a group's mean,
-  /// degrees) vote for the same rotation (the paper: 10 degrees).
-  float rotation_cluster_deg = 10.f;
-  /// A scene pixel under the rendered mask belongs to the object when its depth lies within
-  /// this fraction of the object's diameter of the rendered depth there. Nearer is an
-  /// occluder, farther is what lies behind the object (the mask is still misplaced by up to a
-  /// few centimetres at this stage).
-  float depth_band_fraction = 0.3f;
-  /// The scene crop that refinement and verification see: the rendered object's box grown by
-  /// this fraction of its size on every side, depths within the band of the rendered range.
-  float crop_margin_fraction = 0.25f;
-  /// Fewer scene points than this under the mask (a black hole in the depth map, an object
-  /// seen through a gap): the hypothesis is rejected.
-  std::size_t min_scene_points = 50;
-};
-
-/// Throws InputError naming the bad value.
-void validateInitialPoseParams(const InitialPoseParams& params);
 
 /// Axis-angle distance between two rotations, radians in [0, pi].
 float rotationDistance(const Eigen::Matrix3f& a, const Eigen::Matrix3f& b);

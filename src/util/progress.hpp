@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-namespace vkpose::cli {
+namespace vkpose::util {
 
 class ProgressBar {
  public:
@@ -43,4 +43,4 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
 };
 
-}  // namespace vkpose::cli
+}  // namespace vkpose::util

@@ -3,9 +3,9 @@
 // against: templates convert both ways, so both match the very same templates.
 #include <opencv2/rgbd/linemod.hpp>
 
-#include "vkpose/features.hpp"
-#include "vkpose/matcher.hpp"
-#include "vkpose/templates.hpp"
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
 

@@ -1,0 +1,211 @@
+#pragma once
+// Training (stage 0) and the template bank: training views on a (hemi)sphere, templates
+// rendered from a mesh with their LINEMOD features, the pose each was rendered at and the
+// depth/normal crops the cluster score compares; the bank file that stores them, and a cache
+// of banks kept between runs.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vkpose/device.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
+
+namespace vkpose {
+
+// ---- training views --------------------------------------------------------------------
+
+/// An evenly stepped range, both ends included: from, from + step, ..., to.
+struct SteppedRange {
+  float from = 0.f, to = 0.f, step = 1.f;
+  std::vector<float> values() const;
+};
+
+/// Parses "A:B:STEP" (or a single value "A"); throws InputError on nonsense.
+SteppedRange parseSteppedRange(const std::string& text, const std::string& what);
+
+struct ViewSamplingParams {
+  /// Viewpoints on the (hemi)sphere, spread by a Fibonacci lattice. Paper: 216.
+  int viewpoints = 216;
+  /// Upper hemisphere (object +z up, cameras above the object's centre) or the full sphere.
+  bool full_sphere = false;
+  /// Camera distances from the object's centre, metres. Paper: 0.6 to 1.0 m, 0.1 m apart.
+  SteppedRange radii{0.6f, 1.0f, 0.1f};
+  /// In-plane rotations about the optical axis, degrees. Paper: -60 to +60, 10 apart.
+  SteppedRange inplane_deg{-60.f, 60.f, 10.f};
+};
+
+/// Throws InputError when the counts or ranges are out of bounds.
+void validateViewSampling(const ViewSamplingParams& params);
+
+/// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`
+/// (in object coordinates) on the optical axis at `distance`.
+struct TrainingView {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();
+  float distance = 0.f;     ///< metres from the camera to the object's centre
+  float inplane_deg = 0.f;  ///< in-plane rotation of this view
+  int viewpoint = 0;        ///< index of the viewpoint on the sphere
+};
+
+/// Unit directions from the object's centre to the cameras: a Fibonacci lattice over the
+/// upper hemisphere (z >= 0) or the whole sphere.
+std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere);
+
+/// A camera at `centre + distance * direction` looking at `centre`, image "up" along the
+/// object's +z where possible (+y at the poles), then rotated in-plane by `inplane_deg`.
+TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f& centre, float distance,
+                        float inplane_deg);
+
+/// All views, viewpoint-major, then radius, then in-plane rotation.
+std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre);
+
+/// The views whose camera sits within `max_polar_deg` of the object's +z axis, seen from
+/// `centre`: for objects that only ever stand upright under a camera looking down, the rest
+/// of the hemisphere is templates that can only match wrongly.
+std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
+                                     float max_polar_deg);
+
+// ---- LINEMOD templates -----------------------------------------------------------------
+
+struct TemplateFeature {
+  int x = 0, y = 0;  ///< pixels at the template's level, relative to its top-left corner
+  uint8_t bin = 0;   ///< orientation bin 0..7
+  Modality modality = Modality::ColourGradient;
+};
+
+struct TemplateLevel {
+  int width = 0, height = 0;  ///< pixels at this level
+  std::vector<TemplateFeature> features;
+};
+
+/// One view of one object; levels finest first, as many as FeatureParams::T.
+struct LinemodTemplate {
+  std::vector<TemplateLevel> levels;
+};
+
+/// Cells (pixels / T) a template spans at a level, as LINEMOD counts them: (size - 1) / T + 1.
+inline int templateCells(int size_px, int T) { return size_px <= 0 ? 1 : (size_px - 1) / T + 1; }
+
+/// Throws InputError when a template has the wrong number of levels, no features, a negative
+/// or out-of-range position, a bin outside 0..7, or a modality that FeatureParams switches off.
+void validateTemplates(const std::vector<LinemodTemplate>& templates, const FeatureParams& params);
+
+// ---- training and bank files ----------------------------------------------------------
+
+struct TrainingParams {
+  ViewSamplingParams views;
+  /// Quantization and pyramid, the same as detection uses (T = {5, 8} by default).
+  FeatureParams features;
+  /// Features per modality per pyramid level. LINEMOD: 63 (more are allowed: sums widen).
+  int features_per_modality = 63;
+  /// Colour features need a gradient magnitude above this (OpenCV's strong threshold: 55).
+  float strong_threshold = 55.f;
+  /// Focal lengths of the camera the bank is for: templates are scale-specific.
+  Camera camera;
+  /// The object looks the same under some rotation (evaluation uses ADI instead of ADD).
+  bool symmetric = false;
+};
+
+/// Throws InputError naming the bad value.
+void validateTrainingParams(const TrainingParams& params);
+
+/// Depth and normals of a rendered template, sampled every `stride` pixels over the object's
+/// box: cell (i, j) is template pixel (x0 + j * stride, y0 + i * stride) (level 0, relative
+/// to the template's top-left corner; x0, y0 <= 0 when the object reaches past the features).
+struct TemplateCrop {
+  int x0 = 0, y0 = 0;
+  int stride = 1;
+  int cols = 0, rows = 0;
+  std::vector<uint16_t> depth_01mm;  ///< depth in 0.1 mm units, 0 = not the object
+  std::vector<int8_t> normals;       ///< 3 per cell: unit camera-frame normal * 127
+};
+
+/// Cells per side of a template crop, at most.
+constexpr int kCropCells = 24;
+
+struct BankTemplate {
+  LinemodTemplate linemod;  ///< features per pyramid level
+  Pose pose;                ///< object-to-camera pose the template was rendered at
+  float distance = 0.f;     ///< training distance d, metres (camera to the object's centre)
+  float inplane_deg = 0.f;
+  int viewpoint = 0;
+  /// Where the object's centre projects, in level-0 pixels from the template's top-left.
+  float anchor_x = 0.f, anchor_y = 0.f;
+  TemplateCrop crop;
+};
+
+/// Everything detection needs about one object.
+struct TemplateBank {
+  std::string object;        ///< the mesh file's stem
+  uint64_t mesh_hash = 0;    ///< FNV-1a 64 of the mesh file
+  float diameter = 0.f;      ///< metres
+  bool symmetric = false;
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  ///< the point the cameras look at (object frame)
+  /// The mesh the bank was trained from (metres): the pose stages render it and compare it
+  /// with the scene, so a bank file is all that detection needs.
+  Mesh mesh;
+  TrainingParams params;
+  std::vector<BankTemplate> templates;
+
+  std::vector<LinemodTemplate> linemodTemplates() const;
+};
+
+/// Called after each batch of views: (views done, views in all).
+using TrainingProgress = std::function<void(std::size_t, std::size_t)>;
+
+/// Per-stage training times.
+struct TrainingTimings {
+  double render_ms = 0, features_ms = 0, total_ms = 0;
+  std::size_t dropped = 0;  ///< views with too few features to make a template
+};
+
+/// Renders every view of `params.views` on the GPU and extracts LINEMOD features from each,
+/// as LINEMOD selects them: colour gradients on the silhouette and strong inner edges
+/// (5x5 non-maximum suppression, magnitude above the strong threshold), normals inside the
+/// eroded mask (centres of uniform regions first), spread out over the object.
+TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                            const TrainingProgress& progress = {}, TrainingTimings* timings = nullptr);
+
+/// The same for an explicit list of views (e.g. a subset of sampleViews()); views that differ
+/// only in in-plane rotation must be consecutive to share a rendering.
+TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                                     const std::vector<TrainingView>& views, const TrainingProgress& progress = {},
+                                     TrainingTimings* timings = nullptr);
+
+/// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
+/// FNV-1a 64 checksum of everything before it.
+constexpr uint32_t kBankVersion = 2;  // 2: the mesh is stored
+void saveBank(const TemplateBank& bank, const std::string& path);
+/// Throws InputError naming the file and the problem: missing, not a bank, another version,
+/// truncated, or a checksum mismatch.
+TemplateBank loadBank(const std::string& path);
+
+// ---- banks cached between runs --------------------------------------------------------
+
+/// FNV-1a 64 of what a bank is trained from: the bank format version, the mesh as the bank
+/// stores it, the training parameters and every view.
+uint64_t trainingKey(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views);
+
+/// Where banks are cached: $VKPOSE_CACHE_DIR, else $XDG_CACHE_HOME/vkpose/banks, else
+/// $HOME/.cache/vkpose/banks; empty when none of them is set.
+std::string defaultBankCacheDir();
+
+struct CachedBank {
+  TemplateBank bank;
+  bool from_cache = false;  ///< read back rather than trained
+  std::string path;         ///< the cache file (empty without a cache folder)
+};
+
+/// The bank of `mesh` trained from `views`: read from `cache_dir`/NAME-KEY.vkpb when it is
+/// there and sound, else trained and written there (beside and renamed, so a reader in another
+/// process never sees half a file). A damaged cache file is trained again and replaced. An
+/// empty `cache_dir` trains without caching.
+CachedBank loadOrTrainBank(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                           const std::vector<TrainingView>& views, const std::string& cache_dir,
+                           const TrainingProgress& progress = {});
+
+}  // namespace vkpose

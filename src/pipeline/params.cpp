@@ -1,0 +1,95 @@
+// The checks of every stage's parameters (include/vkpose/config.hpp), in one GPU-, PCL- and
+// OctoMap-free file: the config file reader and its fuzz target link it without the stages.
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "vkpose/config.hpp"
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+void validateScoreParams(const ScoreParams& p) {
+  auto positive = [](float v, const char* name) {
+    if (!(v > 0.f) || !std::isfinite(v)) throw InputError(std::string("cluster score: ") + name + " must be positive");
+  };
+  positive(p.depth_unit_m, "depth unit");
+  positive(p.depth_cap_m, "depth cap");
+  positive(p.angle_unit_rad, "angle unit");
+  positive(p.normal_max_jump_m, "normal depth jump");
+  if (p.normal_step_px < 1 || p.normal_step_px > 16) throw InputError("cluster score: normal step must be 1..16 pixels");
+  if (!(p.min_valid_fraction >= 0.f && p.min_valid_fraction <= 1.f))
+    throw InputError("cluster score: minimum valid fraction must be in [0, 1]");
+  if (p.top_members < 1) throw InputError("cluster score: top members must be at least 1");
+  if (p.max_members < 0) throw InputError("cluster score: max members must be >= 0 (0: all)");
+}
+
+void validateInitialPoseParams(const InitialPoseParams& p) {
+  if (!(p.rotation_cluster_deg > 0.f && p.rotation_cluster_deg <= 180.f))
+    throw InputError(fmt::format("the rotation cluster angle must be in (0, 180] degrees, not {}",
+                                 p.rotation_cluster_deg));
+  if (!(p.depth_band_fraction > 0.f && p.depth_band_fraction <= 10.f))
+    throw InputError(fmt::format("the depth band must be in (0, 10] diameters, not {}", p.depth_band_fraction));
+  if (!(p.crop_margin_fraction >= 0.f && p.crop_margin_fraction <= 10.f))
+    throw InputError(fmt::format("the crop margin must be in [0, 10] object sizes, not {}", p.crop_margin_fraction));
+}
+
+void validateRefineParams(const RefineParams& p) {
+  // The same messages as smoothMls gives for its own arguments (src/pose/refine.cpp).
+  if (p.mls && (!(p.mls_radius > 0.f) || !std::isfinite(p.mls_radius)))
+    throw InputError(fmt::format("MLS radius must be positive and finite, got {}", p.mls_radius));
+  if (p.mls && p.mls_polynomial_order < 0)
+    throw InputError(fmt::format("MLS polynomial order must be >= 0, got {}", p.mls_polynomial_order));
+  if (!std::isfinite(p.voxel_size) || p.voxel_size < 0.f)
+    throw InputError(fmt::format("voxel size must be >= 0 and finite, got {}", p.voxel_size));
+  for (float f : {p.coarse_fraction, p.fine_fraction})
+    if (!(f > 0.f && f <= 1.f)) throw InputError(fmt::format("ICP threshold fractions must lie in (0, 1], got {}", f));
+  if (p.coarse_iterations < 0 || p.fine_iterations < 0)
+    throw InputError(fmt::format("ICP iteration limits must be >= 0, got {} and {}", p.coarse_iterations,
+                                 p.fine_iterations));
+  if (!(p.convergence_epsilon >= 0.0))
+    throw InputError(fmt::format("ICP convergence epsilon must be >= 0, got {}", p.convergence_epsilon));
+  if (!std::isfinite(p.fixed_max_correspondence_m) || p.fixed_max_correspondence_m < 0.f)
+    throw InputError(fmt::format("fixed max correspondence distance must be >= 0, got {}",
+                                 p.fixed_max_correspondence_m));
+}
+
+void validateVerifyParams(const VerifyParams& params) {
+  if (!(params.resolution > 0.f) || !std::isfinite(params.resolution))
+    throw InputError(fmt::format("octree resolution must be positive and finite, got {}", params.resolution));
+  if (!(params.crop_margin >= 0.f) || !std::isfinite(params.crop_margin))
+    throw InputError(fmt::format("verification crop margin must be >= 0 and finite, got {}", params.crop_margin));
+  if (!std::isfinite(params.threshold))
+    throw InputError(fmt::format("collision rate threshold must be finite, got {}", params.threshold));
+  if (!(params.see_through_tolerance >= 0.f) || !std::isfinite(params.see_through_tolerance))
+    throw InputError(fmt::format("see-through tolerance must be >= 0 metres, got {}", params.see_through_tolerance));
+  if (!(params.max_see_through >= 0.f && params.max_see_through <= 1.f))
+    throw InputError(fmt::format("the largest see-through share must be in [0, 1], got {}", params.max_see_through));
+  if (!(params.silhouette_jump > 0.f) || !std::isfinite(params.silhouette_jump))
+    throw InputError(fmt::format("the silhouette step must be > 0 metres, got {}", params.silhouette_jump));
+  if (!(params.min_silhouette_support >= 0.f && params.min_silhouette_support <= 1.f))
+    throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
+}
+
+void validateDetectorParams(const DetectorParams& p) {
+  if (!(p.match.threshold > 0.f && p.match.threshold <= 100.f))
+    throw InputError(fmt::format("the match threshold must be in (0, 100] percent, not {}", p.match.threshold));
+  if (p.cluster.position_step_px < 1 || p.cluster.min_templates < 1)
+    throw InputError(fmt::format("the clustering cell ({} px) and the smallest cluster ({} templates) must be 1 or more",
+                                 p.cluster.position_step_px, p.cluster.min_templates));
+  if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f))
+    throw InputError("the NMS radius must be 0 or more pixels and its fraction more than 0");
+  validateScoreParams(p.score);
+  if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
+  if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");
+  if (p.pose_candidates_per_object < 1)
+    throw InputError(fmt::format("pose candidates per object must be at least 1, not {}", p.pose_candidates_per_object));
+  validateInitialPoseParams(p.initial_pose);
+  validateRefineParams(p.refine);
+  validateVerifyParams(p.verify);
+  if (!(p.duplicate_fraction >= 0.f && p.duplicate_fraction <= 10.f))
+    throw InputError(fmt::format("the duplicate distance must be in [0, 10] diameters, not {}", p.duplicate_fraction));
+}
+
+}  // namespace vkpose
