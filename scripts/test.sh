@@ -2,7 +2,7 @@
 # Configures, builds (warnings are errors) and runs the whole test suite with ctest, every test
 # under the Vulkan validation layer (a validation error fails the test that caused it); then
 # the `asan` preset (AddressSanitizer + UndefinedBehaviorSanitizer) builds and runs the tests
-# of the CPU stages, the file readers and the CLI (README.md, "Reliability").
+# of the CPU stages, the file readers and the CLI (docs/reliability.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release >/dev/null
