@@ -5,6 +5,8 @@
 # of the CPU stages, the file readers and the CLI (docs/reliability.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# In CI the real frames are always there: a test that would skip for want of them fails instead.
+if [ "${CI:-}" = true ]; then export VKPOSE_REQUIRE_DATA=1; fi
 cmake --preset release >/dev/null
 cmake --build --preset release
 ctest --preset release

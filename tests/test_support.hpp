@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers of the test suites: the real frames in ../shared/data, skipping with a
 // clear message when it is absent, and LINEMOD templates cut from a frame.
+#include <cstdlib>
 #include <functional>
 #include <initializer_list>
 #include <optional>
@@ -42,8 +43,13 @@ GpuContext& context();
 
 }  // namespace vkpose::test
 
+// Without ../shared/data a test that needs it skips, except where VKPOSE_REQUIRE_DATA is set
+// (scripts/test.sh sets it under CI=true): there a missing data folder must fail, not pass green.
 #define VKPOSE_REQUIRE_SHARED_DATA()                                                          \
   do {                                                                                        \
-    if (!::vkpose::test::haveSharedData())                                                    \
+    if (!::vkpose::test::haveSharedData()) {                                                  \
+      if (std::getenv("VKPOSE_REQUIRE_DATA"))                                                 \
+        FAIL() << "../shared/data is absent, and VKPOSE_REQUIRE_DATA says it must be there";  \
       GTEST_SKIP() << "../shared/data is absent: this test needs the real RGB-D frames";      \
+    }                                                                                         \
   } while (0)
