@@ -71,6 +71,24 @@ expect "detect: the frame works" 0 "$vkpose" -q detect --bank "$dir/cube.vkpb" "
 expect "detect: missing bank file" 1 "$vkpose" detect --bank "$dir/absent.vkpb" "${frame[@]}"
 expect "detect: missing depth image" 1 "$vkpose" detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
   --depth "$dir/absent.png" --camera "$dir/camera.json"
+# Sequences: a folder of frames (rgb/ and depth/) and a list file, one detector for all frames.
+mkdir -p "$dir/seq/rgb" "$dir/seq/depth"
+for n in 000000 000001; do cp "$dir/rgb.png" "$dir/seq/rgb/$n.png"; cp "$dir/depth.png" "$dir/seq/depth/$n.png"; done
+expect "detect: a folder of frames" 0 "$vkpose" -q detect --bank "$dir/cube.vkpb" --frames "$dir/seq" \
+  --camera "$dir/camera.json" --out-dir "$dir/seq_out" --no-pose
+for n in 000000 000001; do
+  [ -s "$dir/seq_out/$n.json" ] || { echo "FAIL detect --frames wrote no $n.json"; failed=1; }
+done
+printf '# colour depth\nseq/rgb/000000.png seq/depth/000000.png\nseq/rgb/000001.png seq/depth/absent.png\n' >"$dir/frames.txt"
+expect "detect: a list with a missing depth image" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" --list "$dir/frames.txt" \
+  --camera "$dir/camera.json" --jsonl "$dir/frames.jsonl" --no-pose
+[ "$(grep -c '' "$dir/frames.jsonl")" -eq 2 ] || { echo "FAIL detect --list: expected a JSON line per frame"; failed=1; }
+expect "detect: sequence outputs exist" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" --frames "$dir/seq" \
+  --camera "$dir/camera.json" --out-dir "$dir/seq_out" --no-pose
+expect "detect: a sequence without --out-dir or --jsonl" 1 "$vkpose" detect --bank "$dir/cube.vkpb" --frames "$dir/seq" \
+  --camera "$dir/camera.json"
+expect "detect: neither a frame nor a sequence" 2 "$vkpose" detect --bank "$dir/cube.vkpb" --camera "$dir/camera.json"
+expect "detect: a frame and a sequence" 2 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --frames "$dir/seq"
 expect "detect: wrong flag" 2 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --no-such-flag
 expect "detect: no Vulkan driver" 3 env VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json \
   "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}"

@@ -1,15 +1,24 @@
-// `vkpose detect --bank BANK ... --rgb RGB --depth DEPTH --camera camera.json`: stages 1-5 on
+// `vkpose detect --bank BANK ... --rgb RGB --depth DEPTH --camera camera.json`: stages 1-8 on
 // one frame, for several objects at once; prints the detections and the time of each stage,
-// and writes the detection JSON and an overlay PNG.
+// and writes the detection JSON and an overlay PNG. With --frames DIR or --list FILE instead of
+// --rgb/--depth, a sequence of frames in one process: the banks are loaded and the detector is
+// set up once, and each frame's JSON (and overlay) goes to --out-dir, or all frames' JSON to
+// one JSON Lines file (--jsonl).
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "util/progress.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/evaluation.hpp"
 #include "vkpose/frame.hpp"
 
 namespace vkpose::cli {
@@ -20,12 +29,202 @@ namespace {
 struct DetectOptions {
   std::vector<std::string> banks;
   std::string rgb, depth, camera, camera_entry, out, overlay, config;
+  std::string frames, list, out_dir, jsonl;  // sequences
+  bool overlays = false;
   OverlayOptions overlay_options;
   bool side_by_side = false;
   double depth_scale = 0;  // 0: the camera file's
   bool force = false;
   DetectorParams params;
 };
+
+/// One frame of a sequence: its images, the name its outputs take, and its camera.
+struct SequenceFrame {
+  std::string rgb, depth, name;
+  Camera camera;
+};
+
+namespace fs = std::filesystem;
+
+/// The frames of DIR/rgb and DIR/depth (a BOP scene folder: the same file stem in both; the
+/// colour may be .png or .jpg). Cameras: `camera_path` when given, else DIR/scene_camera.json's
+/// entry of each frame's number.
+std::vector<SequenceFrame> framesOfFolder(const std::string& dir, const std::string& camera_path,
+                                          const std::string& camera_entry, double depth_scale) {
+  const fs::path rgb_dir = fs::path(dir) / "rgb", depth_dir = fs::path(dir) / "depth";
+  if (!fs::is_directory(rgb_dir) || !fs::is_directory(depth_dir))
+    throw InputError(fmt::format("{}: expected the folders rgb/ and depth/ in it (a BOP scene folder)", dir));
+  std::map<int, Camera> scene_cameras;
+  Camera fixed;
+  const bool per_frame = camera_path.empty();
+  if (per_frame) {
+    const fs::path scene_camera = fs::path(dir) / "scene_camera.json";
+    if (!fs::exists(scene_camera))
+      throw InputError(fmt::format("{}: no scene_camera.json in it; pass --camera FILE", dir));
+    scene_cameras = loadSceneCamera(scene_camera.string());
+  } else {
+    fixed = loadCamera(camera_path, camera_entry);
+  }
+  std::vector<SequenceFrame> frames;
+  std::vector<fs::path> colour;
+  for (const auto& entry : fs::directory_iterator(rgb_dir)) {
+    const std::string ext = entry.path().extension().string();
+    if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) colour.push_back(entry.path());
+  }
+  std::sort(colour.begin(), colour.end());
+  for (const fs::path& rgb : colour) {
+    SequenceFrame f;
+    f.rgb = rgb.string();
+    f.depth = (depth_dir / (rgb.stem().string() + ".png")).string();
+    f.name = rgb.stem().string();
+    if (per_frame) {
+      int id = -1;
+      try {
+        id = std::stoi(f.name);
+      } catch (const std::exception&) {
+      }
+      const auto it = scene_cameras.find(id);
+      if (it == scene_cameras.end())
+        throw InputError(fmt::format("{}: scene_camera.json has no entry for frame {}", dir, f.name));
+      f.camera = it->second;
+    } else {
+      f.camera = fixed;
+    }
+    if (depth_scale > 0) f.camera.depth_scale = depth_scale;
+    frames.push_back(f);
+  }
+  if (frames.empty()) throw InputError(fmt::format("{}: no colour images (.png, .jpg) in rgb/", dir));
+  return frames;
+}
+
+/// The frames of a list file: one "RGB DEPTH" pair a line (paths relative to the list's
+/// folder unless absolute; blank lines and lines starting with # are skipped), all seen by
+/// the camera of `camera_path`.
+std::vector<SequenceFrame> framesOfList(const std::string& list, const std::string& camera_path,
+                                        const std::string& camera_entry, double depth_scale) {
+  std::ifstream in(list);
+  if (!in) throw InputError(fmt::format("{}: cannot open the frame list", list));
+  if (camera_path.empty()) throw InputError("--list needs --camera FILE");
+  Camera camera = loadCamera(camera_path, camera_entry);
+  if (depth_scale > 0) camera.depth_scale = depth_scale;
+  const fs::path base = fs::path(list).parent_path();
+  std::vector<SequenceFrame> frames;
+  std::map<std::string, int> names;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    std::string rgb, depth, extra;
+    if (!(fields >> rgb >> depth) || (fields >> extra))
+      throw InputError(fmt::format("{}:{}: expected two paths, the colour image and the depth image", list, number));
+    auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
+    SequenceFrame f{resolve(rgb), resolve(depth), fs::path(rgb).stem().string(), camera};
+    // Two frames with the same file name (from different folders) get distinct output names.
+    if (const int seen = names[f.name]++; seen > 0) f.name += fmt::format("_{}", seen + 1);
+    frames.push_back(f);
+  }
+  if (frames.empty()) throw InputError(fmt::format("{}: lists no frames", list));
+  return frames;
+}
+
+/// A file the sequence is about to write: InputError when it exists and --force was not given.
+void checkWritable(const std::string& path, bool force) {
+  if (!force && fs::exists(path)) throw InputError(path + " exists: pass --force to overwrite it");
+}
+
+std::vector<TemplateBank> loadBanks(const std::vector<std::string>& paths, bool quiet) {
+  std::vector<TemplateBank> banks;
+  ProgressBar bar("loading banks", quiet);
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    banks.push_back(loadBank(paths[i]));
+    bar.update(i + 1, paths.size());
+  }
+  return banks;
+}
+
+/// Image size of a frame's overlay camera: scene_camera.json entries carry none.
+Camera withFrameSize(Camera camera, const LinemodFrame& frame) {
+  camera.width = frame.bgr.cols;
+  camera.height = frame.bgr.rows;
+  return camera;
+}
+
+/// --frames / --list: every frame through one detector. A frame that cannot be used (a missing
+/// or corrupt image, another size) is reported and skipped; the command then exits 1.
+ExitCode runSequence(const DetectOptions& opt, const DetectorParams& params, const GlobalOptions& global) {
+  if (opt.out_dir.empty() && opt.jsonl.empty())
+    throw InputError("a frame sequence needs --out-dir DIR or --jsonl FILE for its results");
+  if (!opt.out.empty() || !opt.overlay.empty())
+    throw InputError("--out and --overlay are for one frame: a sequence writes to --out-dir or --jsonl");
+  if (opt.overlays && opt.out_dir.empty()) throw InputError("--overlays needs --out-dir");
+  const std::vector<SequenceFrame> frames =
+      !opt.frames.empty() ? framesOfFolder(opt.frames, opt.camera, opt.camera_entry, opt.depth_scale)
+                          : framesOfList(opt.list, opt.camera, opt.camera_entry, opt.depth_scale);
+  // Every output is checked before any work, so a run never stops half-way for a file that exists.
+  auto outPath = [&](const SequenceFrame& f, const char* ext) { return (fs::path(opt.out_dir) / (f.name + ext)).string(); };
+  if (!opt.out_dir.empty()) {
+    fs::create_directories(opt.out_dir);
+    for (const SequenceFrame& f : frames) {
+      checkWritable(outPath(f, ".json"), opt.force);
+      if (opt.overlays) checkWritable(outPath(f, ".png"), opt.force);
+    }
+  }
+  std::ofstream jsonl;
+  if (!opt.jsonl.empty()) {
+    checkWritable(opt.jsonl, opt.force);
+    jsonl.open(opt.jsonl, std::ios::trunc);
+    if (!jsonl) throw InputError(opt.jsonl + ": cannot be written");
+  }
+
+  GpuContext ctx(global.gpu());
+  Detector detector(ctx, loadBanks(opt.banks, global.quiet), params);
+  if (!global.quiet)
+    fmt::print("{} frame{}, {} object{} on {}\n", frames.size(), frames.size() == 1 ? "" : "s", opt.banks.size(),
+               opt.banks.size() == 1 ? "" : "s", ctx.device().name);
+  ProgressBar bar("detecting", global.quiet);
+  std::size_t detections = 0, failed = 0;
+  std::vector<double> frame_ms;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const SequenceFrame& f = frames[i];
+    try {
+      const LinemodFrame frame = loadFrame(f.rgb, f.depth, f.camera.depth_scale);
+      const auto t0 = std::chrono::steady_clock::now();
+      const DetectionResult result = detector.detect(frame, f.camera);
+      frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      detections += result.detections.size();
+      const std::string json = detectionJson(result, {f.rgb, f.depth, ctx.device().name});
+      if (!opt.out_dir.empty()) writeTextFile(outPath(f, ".json"), json, true);
+      if (jsonl.is_open()) jsonl << nlohmann::json::parse(json).dump() << '\n';
+      if (opt.overlays)
+        writeImage(outPath(f, ".png"),
+                   drawDetections(frame.bgr, result, detector.banks(), withFrameSize(f.camera, frame),
+                                  opt.overlay_options),
+                   true);
+      if (global.verbose) {
+        bar.finish();
+        fmt::print("{}: {} detection{}, {:.0f} ms\n", f.name, result.detections.size(),
+                   result.detections.size() == 1 ? "" : "s", frame_ms.back());
+      }
+    } catch (const InputError& e) {
+      ++failed;
+      bar.finish();
+      fmt::print(stderr, "vkpose: frame {}: {}\n", f.name, e.what());
+      if (jsonl.is_open()) jsonl << nlohmann::json{{"rgb", f.rgb}, {"depth", f.depth}, {"error", e.what()}}.dump() << '\n';
+    }
+    bar.update(i + 1, frames.size());
+  }
+  bar.finish();
+  if (!jsonl) throw InputError(opt.jsonl + ": writing failed");
+  std::vector<double> sorted = frame_ms;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+  fmt::print("{} of {} frames, {} detection{}, median {:.0f} ms a frame ({:.2f} frames/s); results in {}\n",
+             frames.size() - failed, frames.size(), detections, detections == 1 ? "" : "s", median,
+             median > 0 ? 1000.0 / median : 0.0, opt.out_dir.empty() ? opt.jsonl : opt.out_dir);
+  return failed > 0 ? kBadInput : kOk;
+}
+
 }  // namespace
 
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
@@ -34,10 +233,22 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   auto* sub = app.add_subcommand("detect", "Find the objects of one or more template banks in an RGB-D frame");
   sub->add_option("--bank", opt->banks, "Template bank (.vkpb) of an object; repeat for several objects")
       ->required();  // a missing bank is bad input (exit 1, loadBank names it), not a usage error
-  sub->add_option("--rgb", opt->rgb, "Colour image (PNG/JPEG, 8-bit)")->required();
-  sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)")->required();
-  sub->add_option("--camera", opt->camera, "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json")
-      ->required();
+  // The input: one frame (--rgb with --depth) or a sequence (--frames or --list), exactly one.
+  auto* input = sub->add_option_group("Input", "One frame (--rgb and --depth) or a sequence (--frames or --list)");
+  auto* rgb = input->add_option("--rgb", opt->rgb, "Colour image (PNG/JPEG, 8-bit)");
+  auto* frames = input->add_option("--frames", opt->frames,
+                                   "Folder of a frame sequence: rgb/ and depth/ with the same file names (a BOP scene "
+                                   "folder; cameras from its scene_camera.json unless --camera is given)");
+  auto* list = input->add_option("--list", opt->list,
+                                 "Text file of a frame sequence: a colour and a depth image path per line");
+  input->require_option(1);
+  auto* depth = sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)");
+  rgb->needs(depth);
+  depth->needs(rgb);
+  depth->excludes(frames)->excludes(list);
+  sub->add_option("--camera", opt->camera,
+                  "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json (required but with "
+                  "--frames of a folder that has a scene_camera.json)");
   sub->add_option("--camera-entry", opt->camera_entry, "Key of the scene_camera.json entry (default: the first)");
   sub->add_option("--depth-scale", opt->depth_scale,
                   "Millimetres per depth-PNG unit (default: the camera file's depth_scale, else 1)")
@@ -49,7 +260,11 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                 "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
   sub->add_flag("--side-by-side", opt->side_by_side,
                 "Put the depth image (false colour, with the same drawing) to the right of the colour overlay");
-  sub->add_flag("--force", opt->force, "Overwrite --out and --overlay if they exist");
+  sub->add_option("--out-dir", opt->out_dir,
+                  "Sequences: folder for one detection JSON per frame (NAME.json, NAME the colour image's stem)");
+  sub->add_option("--jsonl", opt->jsonl, "Sequences: one JSON Lines file, a frame's detection JSON per line");
+  sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir");
+  sub->add_flag("--force", opt->force, "Overwrite output files that exist");
   addConfigOption(sub, opt->config);
   auto* stages = "Stage parameters";
   sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
@@ -113,6 +328,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->group(stages);
   return [opt, &global]() {
     const DetectorParams params = withConfig(opt->config, opt->params);
+    if (!opt->frames.empty() || !opt->list.empty()) return runSequence(*opt, params, global);
+    if (opt->camera.empty()) throw InputError("detect needs --camera FILE for --rgb/--depth");
     for (const auto* path : {&opt->out, &opt->overlay})
       if (!path->empty() && !opt->force && std::filesystem::exists(*path))
         throw InputError(*path + " exists: pass --force to overwrite it");
@@ -120,13 +337,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
     if (opt->depth_scale > 0) camera.depth_scale = opt->depth_scale;
     const LinemodFrame frame = loadFrame(opt->rgb, opt->depth, camera.depth_scale);
 
-    std::vector<TemplateBank> banks;
-    ProgressBar bar("loading banks", global.quiet);
-    for (std::size_t i = 0; i < opt->banks.size(); ++i) {
-      banks.push_back(loadBank(opt->banks[i]));
-      bar.update(i + 1, opt->banks.size());
-    }
-    bar.finish();
+    std::vector<TemplateBank> banks = loadBanks(opt->banks, global.quiet);
     GpuContext ctx(global.gpu());
     Detector detector(ctx, std::move(banks), params);
     const DetectionResult result = detector.detect(frame, camera);
@@ -163,12 +374,10 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       if (!global.quiet) fmt::print("wrote {}\n", opt->out);
     }
     if (!opt->overlay.empty()) {
-      Camera image_camera = camera;  // scene_camera.json entries carry no size: the frame's
-      image_camera.width = frame.bgr.cols;
-      image_camera.height = frame.bgr.rows;
       OverlayOptions overlay = opt->overlay_options;
       if (opt->side_by_side) overlay.depth_mm = frame.depth_mm;
-      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), image_camera, overlay), opt->force);
+      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), withFrameSize(camera, frame), overlay),
+                 opt->force);
       if (!global.quiet) fmt::print("wrote {}\n", opt->overlay);
     }
     return kOk;
