@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   } catch (const vkpose::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
-  } catch (const std::exception& e) {
+  } catch (const vkpose::DeviceError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 3;
   }

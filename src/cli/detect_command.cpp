@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_support.hpp"
 #include "cli/commands.hpp"
 #include "util/progress.hpp"
 #include "vkpose/detector.hpp"
@@ -104,7 +105,6 @@ std::vector<SequenceFrame> framesOfList(const std::string& list, const std::stri
                                         const std::string& camera_entry, double depth_scale) {
   std::ifstream in(list);
   if (!in) throw InputError(fmt::format("{}: cannot open the frame list", list));
-  if (camera_path.empty()) throw InputError("--list needs --camera FILE");
   Camera camera = loadCamera(camera_path, camera_entry);
   if (depth_scale > 0) camera.depth_scale = depth_scale;
   const fs::path base = fs::path(list).parent_path();
@@ -155,9 +155,6 @@ Camera withFrameSize(Camera camera, const LinemodFrame& frame) {
 ExitCode runSequence(const DetectOptions& opt, const DetectorParams& params, const GlobalOptions& global) {
   if (opt.out_dir.empty() && opt.jsonl.empty())
     throw InputError("a frame sequence needs --out-dir DIR or --jsonl FILE for its results");
-  if (!opt.out.empty() || !opt.overlay.empty())
-    throw InputError("--out and --overlay are for one frame: a sequence writes to --out-dir or --jsonl");
-  if (opt.overlays && opt.out_dir.empty()) throw InputError("--overlays needs --out-dir");
   const std::vector<SequenceFrame> frames =
       !opt.frames.empty() ? framesOfFolder(opt.frames, opt.camera, opt.camera_entry, opt.depth_scale)
                           : framesOfList(opt.list, opt.camera, opt.camera_entry, opt.depth_scale);
@@ -216,9 +213,7 @@ ExitCode runSequence(const DetectOptions& opt, const DetectorParams& params, con
   }
   bar.finish();
   if (!jsonl) throw InputError(opt.jsonl + ": writing failed");
-  std::vector<double> sorted = frame_ms;
-  std::sort(sorted.begin(), sorted.end());
-  const double median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+  const double median = frame_ms.empty() ? 0 : bench::median(frame_ms);
   fmt::print("{} of {} frames, {} detection{}, median {:.0f} ms a frame ({:.2f} frames/s); results in {}\n",
              frames.size() - failed, frames.size(), detections, detections == 1 ? "" : "s", median,
              median > 0 ? 1000.0 / median : 0.0, opt.out_dir.empty() ? opt.jsonl : opt.out_dir);
@@ -246,24 +241,29 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   rgb->needs(depth);
   depth->needs(rgb);
   depth->excludes(frames)->excludes(list);
-  sub->add_option("--camera", opt->camera,
-                  "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json (required but with "
-                  "--frames of a folder that has a scene_camera.json)");
+  auto* camera_opt = sub->add_option("--camera", opt->camera,
+                                     "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json (required "
+                                     "but with --frames of a folder that has a scene_camera.json)");
+  rgb->needs(camera_opt);
+  list->needs(camera_opt);
   sub->add_option("--camera-entry", opt->camera_entry, "Key of the scene_camera.json entry (default: the first)");
   sub->add_option("--depth-scale", opt->depth_scale,
                   "Millimetres per depth-PNG unit (default: the camera file's depth_scale, else 1)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--out", opt->out, "Detection JSON to write");
+  // One frame's outputs; a sequence writes to --out-dir or --jsonl.
+  sub->add_option("--out", opt->out, "Detection JSON to write")->excludes(frames)->excludes(list);
   sub->add_option("--overlay", opt->overlay,
-                  "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)");
+                  "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)")
+      ->excludes(frames)
+      ->excludes(list);
   sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
                 "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
   sub->add_flag("--side-by-side", opt->side_by_side,
                 "Put the depth image (false colour, with the same drawing) to the right of the colour overlay");
-  sub->add_option("--out-dir", opt->out_dir,
-                  "Sequences: folder for one detection JSON per frame (NAME.json, NAME the colour image's stem)");
+  auto* out_dir = sub->add_option(
+      "--out-dir", opt->out_dir, "Sequences: folder for one detection JSON per frame (NAME.json, NAME the colour image's stem)");
   sub->add_option("--jsonl", opt->jsonl, "Sequences: one JSON Lines file, a frame's detection JSON per line");
-  sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir");
+  sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir")->needs(out_dir);
   sub->add_flag("--force", opt->force, "Overwrite output files that exist");
   addConfigOption(sub, opt->config);
   auto* stages = "Stage parameters";
@@ -329,10 +329,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   return [opt, &global]() {
     const DetectorParams params = withConfig(opt->config, opt->params);
     if (!opt->frames.empty() || !opt->list.empty()) return runSequence(*opt, params, global);
-    if (opt->camera.empty()) throw InputError("detect needs --camera FILE for --rgb/--depth");
-    for (const auto* path : {&opt->out, &opt->overlay})
-      if (!path->empty() && !opt->force && std::filesystem::exists(*path))
-        throw InputError(*path + " exists: pass --force to overwrite it");
+    for (const std::string* path : {&opt->out, &opt->overlay})
+      if (!path->empty()) checkWritable(*path, opt->force);
     Camera camera = loadCamera(opt->camera, opt->camera_entry);
     if (opt->depth_scale > 0) camera.depth_scale = opt->depth_scale;
     const LinemodFrame frame = loadFrame(opt->rgb, opt->depth, camera.depth_scale);

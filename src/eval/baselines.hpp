@@ -17,13 +17,13 @@
 
 #include <opencv2/core.hpp>
 
-#include "vkpose/evaluation.hpp"
-#include "vkpose/geometry.hpp"
 #include "hypotheses/cluster_score.hpp"
-#include "vkpose/detector.hpp"
 #include "match/matcher.hpp"
 #include "render/render.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

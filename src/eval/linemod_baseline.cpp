@@ -39,11 +39,7 @@ DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera&
   DetectionResult result;
   const auto total0 = std::chrono::steady_clock::now();
   const std::vector<Match> matches = matcher_->match(frame);  // best first
-  const MatchTimings& mt = matcher_->lastTimings();
-  if (mt.upload_ms > 0) result.timings_ms.emplace_back("upload", mt.upload_ms);
-  result.timings_ms.emplace_back("features", mt.features_ms);
-  result.timings_ms.emplace_back("similarity", mt.similarity_ms);
-  result.timings_ms.emplace_back("match_readback", mt.finish_ms);
+  appendMatchTimings(matcher_->lastTimings(), result.timings_ms);
   result.matches = matches.size();
 
   // Each match is a one-member hypothesis centred where the match puts the object's centre:

@@ -23,10 +23,10 @@
 
 #include <opencv2/core.hpp>
 
-#include "vkpose/config.hpp"
-#include "vkpose/geometry.hpp"
-#include "vkpose/device.hpp"
 #include "hypotheses/hypotheses.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

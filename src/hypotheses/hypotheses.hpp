@@ -8,9 +8,9 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "vkpose/config.hpp"
 #include "match/matcher.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
 
 namespace vkpose {
 

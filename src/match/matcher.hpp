@@ -7,10 +7,10 @@
 #include <memory>
 #include <vector>
 
-#include "vkpose/config.hpp"
 #include "match/features.hpp"
-#include "vkpose/device.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/device.hpp"
 
 namespace vkpose {
 

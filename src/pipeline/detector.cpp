@@ -90,6 +90,13 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 
 Detector::~Detector() = default;
 
+void appendMatchTimings(const MatchTimings& t, StageTimings& to) {
+  if (t.upload_ms > 0) to.emplace_back("upload", t.upload_ms);
+  to.emplace_back("features", t.features_ms);
+  to.emplace_back("similarity", t.similarity_ms);
+  to.emplace_back("match_readback", t.finish_ms);
+}
+
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera) {
   // The training camera looked at the bank's centre, so the centre sits on the template's
@@ -149,11 +156,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   const auto total0 = t0;
   // Started while the previous frame's CPU stages ran (detectSequence), or now.
   std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
-  const MatchTimings& mt = matcher_->lastTimings();
-  if (mt.upload_ms > 0) result.timings_ms.emplace_back("upload", mt.upload_ms);
-  result.timings_ms.emplace_back("features", mt.features_ms);
-  result.timings_ms.emplace_back("similarity", mt.similarity_ms);
-  result.timings_ms.emplace_back("match_readback", mt.finish_ms);
+  appendMatchTimings(matcher_->lastTimings(), result.timings_ms);
   result.matches = matches.size();
 
   t0 = std::chrono::steady_clock::now();

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "pose/refine.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/error.hpp"
 
@@ -35,12 +36,16 @@ void validateInitialPoseParams(const InitialPoseParams& p) {
     throw InputError(fmt::format("the crop margin must be in [0, 10] object sizes, not {}", p.crop_margin_fraction));
 }
 
+void validateMls(float radius, int order, float seed_voxel) {
+  if (!(radius > 0.f) || !std::isfinite(radius))
+    throw InputError(fmt::format("MLS radius must be positive and finite, got {}", radius));
+  if (order < 0) throw InputError(fmt::format("MLS polynomial order must be >= 0, got {}", order));
+  if (!(seed_voxel >= 0.f) || !std::isfinite(seed_voxel))
+    throw InputError(fmt::format("MLS seed voxel must be >= 0 and finite, got {}", seed_voxel));
+}
+
 void validateRefineParams(const RefineParams& p) {
-  // The same messages as smoothMls gives for its own arguments (src/pose/refine.cpp).
-  if (p.mls && (!(p.mls_radius > 0.f) || !std::isfinite(p.mls_radius)))
-    throw InputError(fmt::format("MLS radius must be positive and finite, got {}", p.mls_radius));
-  if (p.mls && p.mls_polynomial_order < 0)
-    throw InputError(fmt::format("MLS polynomial order must be >= 0, got {}", p.mls_polynomial_order));
+  if (p.mls) validateMls(p.mls_radius, p.mls_polynomial_order, 0.f);
   if (!std::isfinite(p.voxel_size) || p.voxel_size < 0.f)
     throw InputError(fmt::format("voxel size must be >= 0 and finite, got {}", p.voxel_size));
   for (float f : {p.coarse_fraction, p.fine_fraction})

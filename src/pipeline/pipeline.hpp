@@ -1,7 +1,8 @@
 #pragma once
 // Helpers of the per-frame flow that tests and the baselines share.
-#include "vkpose/detector.hpp"
 #include "hypotheses/cluster_score.hpp"
+#include "match/matcher.hpp"
+#include "vkpose/detector.hpp"
 
 namespace vkpose {
 
@@ -15,5 +16,9 @@ Camera frameCamera(const LinemodFrame& frame, const Camera& camera, const Featur
 /// depth offset.
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera);
+
+/// Stages 1-2's times under the names the detection JSON reports them by: "upload" (when the
+/// templates were uploaded), "features", "similarity", "match_readback".
+void appendMatchTimings(const MatchTimings& timings, StageTimings& to);
 
 }  // namespace vkpose

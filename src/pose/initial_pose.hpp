@@ -12,12 +12,12 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "vkpose/config.hpp"
-#include "vkpose/geometry.hpp"
 #include "hypotheses/hypotheses.hpp"
 #include "pose/point_cloud.hpp"
 #include "render/render.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

@@ -98,14 +98,6 @@ Cloud::Ptr mlsPcl(const Cloud::Ptr& in, float radius, int order, float seed_voxe
   return out;
 }
 
-void checkMls(float radius, int order, float seed_voxel) {
-  if (!(radius > 0.f) || !std::isfinite(radius))
-    throw InputError(fmt::format("MLS radius must be positive and finite, got {}", radius));
-  if (order < 0) throw InputError(fmt::format("MLS polynomial order must be >= 0, got {}", order));
-  if (!(seed_voxel >= 0.f) || !std::isfinite(seed_voxel))
-    throw InputError(fmt::format("MLS seed voxel must be >= 0 and finite, got {}", seed_voxel));
-}
-
 }  // namespace
 
 namespace {
@@ -244,7 +236,7 @@ PointCloud voxelFilter(const PointCloud& cloud, float voxel) {
 }
 
 PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel) {
-  checkMls(radius, order, seed_voxel);
+  validateMls(radius, order, seed_voxel);
   return fromPcl(*mlsPcl(toPcl(scene), radius, order, seed_voxel));
 }
 

@@ -6,8 +6,8 @@
 // PCL does the work; it stays inside src/pose/refine.cpp.
 #include <cstddef>
 
-#include "vkpose/config.hpp"
 #include "pose/point_cloud.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/geometry.hpp"
 
 namespace vkpose {
@@ -45,6 +45,10 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
 /// seed_voxel > 0: only the first point of each voxel of that size is fitted and returned
 /// (its neighbourhood still uses every point).
 PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f);
+
+/// InputError unless the MLS radius is positive and finite, the polynomial order >= 0 and the
+/// seed voxel >= 0 and finite (src/pipeline/params.cpp, beside the other parameter checks).
+void validateMls(float radius, int order, float seed_voxel);
 
 /// Voxel grid: one point per occupied cube of side `voxel` (metres), the centroid of its
 /// points. voxel <= 0 returns the finite points unchanged.

@@ -7,9 +7,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "pose/point_cloud.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/geometry.hpp"
-#include "pose/point_cloud.hpp"
 
 namespace vkpose {
 

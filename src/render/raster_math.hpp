@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "vkpose/geometry.hpp"
 #include "render/render.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose::render {
 

@@ -10,8 +10,8 @@
 #include <Eigen/LU>
 #include <opencv2/core.hpp>
 
-#include "vkpose/geometry.hpp"
 #include "vkpose/device.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose {
 

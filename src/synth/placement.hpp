@@ -11,9 +11,9 @@
 #include <random>
 #include <vector>
 
-#include "vkpose/synth.hpp"
-#include "vkpose/geometry.hpp"
 #include "render/render.hpp"
+#include "vkpose/geometry.hpp"
+#include "vkpose/synth.hpp"
 
 namespace vkpose {
 

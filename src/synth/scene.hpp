@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "vkpose/synth.hpp"
 #include "match/features.hpp"
 #include "render/render.hpp"
+#include "vkpose/synth.hpp"
 
 namespace vkpose {
 

@@ -4,8 +4,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "vkpose/bank.hpp"
 #include "render/render.hpp"
+#include "vkpose/bank.hpp"
 
 namespace vkpose {
 
