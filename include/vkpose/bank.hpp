@@ -36,10 +36,51 @@ struct ViewSamplingParams {
   SteppedRange radii{0.6f, 1.0f, 0.1f};
   /// In-plane rotations about the optical axis, degrees. Paper: -60 to +60, 10 apart.
   SteppedRange inplane_deg{-60.f, 60.f, 10.f};
+  /// The object's up direction (object frame, unit): the (hemi)sphere is sampled about it and
+  /// image "up" follows it, so templates show the object as it stands. `vkpose train` finds it
+  /// (findUpAxis) unless --up names one; +z is the modelling convention.
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
 };
 
-/// Throws InputError when the counts or ranges are out of bounds.
+/// Throws InputError when the counts or ranges are out of bounds, or `up` is not a unit vector.
 void validateViewSampling(const ViewSamplingParams& params);
+
+// ---- the up axis -----------------------------------------------------------------------
+
+/// "+x", "-x", "+y", "-y", "+z", "-z" as a unit vector; InputError otherwise.
+Eigen::Vector3f parseUpAxis(const std::string& text);
+/// The name of an axis-aligned unit vector ("-z"), or its components ("(0.000, 0.707, 0.707)").
+std::string upAxisName(const Eigen::Vector3f& up);
+
+/// How the object would rest with one axis up: on its broadest base within 15 degrees of it
+/// (scanned meshes are not modelled exactly axis-aligned).
+struct RestingCandidate {
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  /// Area of what touches the table (points within max(1 mm, 1.5 % of the height) of the
+  /// lowest one), as a share of the object's footprint along `up`.
+  float support = 0.f;
+  float tilt_deg = 0.f;  ///< angle between the base's normal and `up`
+  /// Distance of the centre of mass's projection inside that contact area, metres (negative:
+  /// outside, the object tips over).
+  float margin_m = 0.f;
+  bool stands() const;  ///< stable on a broad enough base (support >= 0.15, margin > 0)
+};
+
+struct UpAxisChoice {
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  bool found = false;  ///< false: no axis gives a stable, broad base; +z is assumed
+  std::vector<RestingCandidate> candidates;  ///< +z, -z, +y, -y, +x, -x
+  std::string reason;  ///< one line for the user
+};
+
+/// The direction the object stands along, from its mesh: of the six axis directions, in the
+/// order +z, -z, +y, -y, +x, -x (the modelling conventions, most common first), the first on
+/// which the object stands (RestingCandidate::stands) on a base at least half as broad as the
+/// broadest it stands on. Meshes are modelled axis-aligned, and a box-like object is stable on
+/// several faces: the order keeps the modeller's +z where the object stands on it, the share
+/// passes over a side it could lie on when its real base is elsewhere, and a mesh modelled
+/// upside down (milk.stl: its cap at -z) is turned the right way up.
+UpAxisChoice findUpAxis(const Mesh& mesh);
 
 /// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`
 /// (in object coordinates) on the optical axis at `distance`.
@@ -55,19 +96,21 @@ struct TrainingView {
 /// upper hemisphere (z >= 0) or the whole sphere.
 std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere);
 
-/// A camera at `centre + distance * direction` looking at `centre`, image "up" along the
-/// object's +z where possible (+y at the poles), then rotated in-plane by `inplane_deg`.
+/// A camera at `centre + distance * direction` looking at `centre`, image "up" along `up`
+/// (the object's up axis) where possible (along the axis perpendicular to it that +y would
+/// become, looking straight down it), then rotated in-plane by `inplane_deg`.
 TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f& centre, float distance,
-                        float inplane_deg);
+                        float inplane_deg, const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
 
-/// All views, viewpoint-major, then radius, then in-plane rotation.
+/// All views, viewpoint-major, then radius, then in-plane rotation; the (hemi)sphere's
+/// viewpoints turned so that its pole is `params.up`.
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre);
 
-/// The views whose camera sits within `max_polar_deg` of the object's +z axis, seen from
+/// The views whose camera sits within `max_polar_deg` of the object's up axis, seen from
 /// `centre`: for objects that only ever stand upright under a camera looking down, the rest
 /// of the hemisphere is templates that can only match wrongly.
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
-                                     float max_polar_deg);
+                                     float max_polar_deg, const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
 
 // ---- LINEMOD templates -----------------------------------------------------------------
 
@@ -178,7 +221,7 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
 
 /// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
 /// FNV-1a 64 checksum of everything before it.
-constexpr uint32_t kBankVersion = 2;  // 2: the mesh is stored
+constexpr uint32_t kBankVersion = 3;  // 2: the mesh is stored; 3: the up axis (2 reads as +z)
 void saveBank(const TemplateBank& bank, const std::string& path);
 /// Throws InputError naming the file and the problem: missing, not a bank, another version,
 /// truncated, or a checksum mismatch.

@@ -43,7 +43,7 @@ std::string cameraRepr(const Camera& c) {
                      c.cy, c.width, c.height, c.depth_scale);
 }
 
-std::string upAxis(const TemplateBank& bank) { return bank.params.views.full_sphere ? "any" : "+z"; }
+std::string upAxis(const TemplateBank& bank) { return upAxisName(bank.params.views.up); }
 
 }  // namespace
 
@@ -153,7 +153,9 @@ void bindCore(py::module_& m) {
       .def_property_readonly(
           "templates", [](const TemplateBank& b) { return b.templates.size(); }, "Number of templates")
       .def_property_readonly("up_axis", &upAxis,
-                             "The object axis the training views are above ('+z'), or 'any' (the full sphere)")
+                             "The object's up axis the views were sampled about ('+z', '-z', ...), mesh frame")
+      .def_property_readonly("hemisphere", [](const TemplateBank& b) { return b.params.views.full_sphere ? "full" : "upper"; },
+                             "'upper': views above the up axis; 'full': the whole sphere")
       .def_property_readonly("camera", [](const TemplateBank& b) { return b.params.camera; },
                              "The camera the templates were rendered for")
       .def_property_readonly("viewpoints", [](const TemplateBank& b) { return b.params.views.viewpoints; })
@@ -177,7 +179,7 @@ void bindCore(py::module_& m) {
           "The mesh's triangles, Mx3 vertex indices")
       .def("__len__", [](const TemplateBank& b) { return b.templates.size(); })
       .def("__repr__", [](const TemplateBank& b) {
-        return fmt::format("<vkpose.Bank '{}': {} templates, diameter {:.4f} m, up {}{}>", b.object,
+        return fmt::format("<vkpose.Bank '{}': {} templates, diameter {:.4f} m, up axis {}{}>", b.object,
                            b.templates.size(), b.diameter, upAxis(b), b.symmetric ? ", symmetric" : "");
       });
 
@@ -185,8 +187,8 @@ void bindCore(py::module_& m) {
       "train",
       [](const py::object& mesh_path, const std::string& units, int views, const py::object& radii,
          const py::object& inplane, const std::string& hemisphere, float max_view_angle, int features,
-         const py::object& camera, bool symmetric, const py::object& device, const py::object& cache_dir,
-         const py::object& progress) {
+         const py::object& camera, bool symmetric, const std::string& up, const py::object& device,
+         const py::object& cache_dir, const py::object& progress) {
         TrainingParams params;
         params.views.viewpoints = views;
         params.views.radii = rangeOf(radii, "radii");
@@ -197,6 +199,7 @@ void bindCore(py::module_& m) {
         params.features_per_modality = features;
         params.symmetric = symmetric;
         if (!camera.is_none()) params.camera = cameraOf(camera, 640, 480, "camera");
+        if (up != "auto") params.views.up = parseUpAxis(up);
         if (!(max_view_angle >= 1.f && max_view_angle <= 180.f))
           valueError(fmt::format("max_view_angle: {} is not within 1..180 degrees", max_view_angle));
         validateTrainingParams(params);
@@ -207,8 +210,9 @@ void bindCore(py::module_& m) {
         const auto report = progressOf(progress, "training");
         py::gil_scoped_release nogil;
         const Mesh mesh = loadMesh(path, mesh_units);
+        if (up == "auto") params.views.up = findUpAxis(mesh).up;
         const std::vector<TrainingView> training_views =
-            viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle);
+            viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle, params.views.up);
         if (training_views.empty())
           throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", max_view_angle));
         std::lock_guard<std::mutex> lock(dev->mutex);
@@ -221,7 +225,8 @@ void bindCore(py::module_& m) {
       py::arg("mesh"), py::kw_only(), py::arg("units") = "auto", py::arg("views") = 216,
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
-      py::arg("symmetric") = false, py::arg("device") = py::none(), py::arg("cache_dir") = py::none(),
+      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("device") = py::none(),
+      py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
 as `vkpose train` does (the same defaults).
@@ -229,9 +234,10 @@ as `vkpose train` does (the same defaults).
 mesh: STL, PLY (colours kept) or OBJ. units: 'mm', 'm' or 'auto' (from the object's size).
 views: viewpoints on the (hemi)sphere. radii: camera distances "FROM:TO:STEP" or (from, to, step),
 metres. inplane: in-plane rotations, degrees. hemisphere: 'upper' or 'full'. max_view_angle:
-keep viewpoints within this angle of the object's +z, degrees. features: per modality and level.
+keep viewpoints within this angle of the up axis, degrees. features: per modality and level.
 camera: the sensor (a Camera, a camera.json path, or a 3x3 K): templates are scale-specific.
-symmetric: score the object with ADI. device: None, an index or a Device. cache_dir: a folder
+symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end it stands on,
++z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

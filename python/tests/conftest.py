@@ -95,3 +95,8 @@ def bracket_bank():
     """A small bank of the demo's angle bracket (a few hundred templates: quick to train)."""
     return vkpose.train(REPO / "assets" / "meshes" / "angle_bracket.ply", units="mm", views=30, radii="0.6:0.8:0.1",
                         inplane="-30:30:30")
+
+
+@pytest.fixture(scope="session")
+def meshes():
+    return _require(SHARED / "meshes", "the shared meshes")

@@ -156,3 +156,13 @@ def test_training_checks_its_arguments_before_any_work(tmp_path):
         vkpose.train(tmp_path / "nosuch.stl")
     with pytest.raises(ValueError, match="progress"):
         vkpose.train(mesh, progress=5)
+
+
+def test_training_finds_the_up_axis(meshes):
+    small = dict(views=2, radii=0.6, inplane=0)
+    milk = vkpose.train(meshes / "milk.stl", units="m", **small)
+    assert milk.up_axis == "-z" and milk.hemisphere == "upper"
+    assert "up axis -z" in repr(milk)
+    assert vkpose.train(meshes / "milk.stl", units="m", up="+z", **small).up_axis == "+z"
+    with pytest.raises(ValueError, match="up axis 'z'"):
+        vkpose.train(meshes / "milk.stl", units="m", up="z", **small)

@@ -20,8 +20,9 @@ void printBankSummary(const TemplateBank& bank, const std::string& path) {
   fmt::print("diameter: {:.4f} m\n", bank.diameter);
   fmt::print("symmetric: {}\n", bank.symmetric ? "yes" : "no");
   fmt::print("templates: {}\n", bank.templates.size());
+  fmt::print("up axis: {}\n", upAxisName(p.views.up));
   fmt::print("views: {} viewpoints ({}), radii {}:{}:{} m, in-plane {}:{}:{} deg\n", p.views.viewpoints,
-             p.views.full_sphere ? "full sphere" : "upper hemisphere", p.views.radii.from, p.views.radii.to,
+             p.views.full_sphere ? "full sphere" : "hemisphere above the up axis", p.views.radii.from, p.views.radii.to,
              p.views.radii.step, p.views.inplane_deg.from, p.views.inplane_deg.to, p.views.inplane_deg.step);
   fmt::print("features: {} per modality and level, T = {}, modalities {}{}, {:.1f} per template\n",
              p.features_per_modality, fmt::join(p.features.T, ","), p.features.use_colour ? "colour " : "",

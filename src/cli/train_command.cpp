@@ -16,7 +16,8 @@ using util::ProgressBar;
 
 namespace {
 struct TrainOptions {
-  std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera;
+  std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
+      up = "auto";
   int views = 216, features = 63;
   float max_view_angle = 180.f;
   bool symmetric = false, force = false;
@@ -33,6 +34,7 @@ TrainingParams trainingParamsFrom(const TrainOptions& o) {
   p.features_per_modality = o.features;
   p.symmetric = o.symmetric;
   if (!o.camera.empty()) p.camera = loadCamera(o.camera);
+  if (o.up != "auto") p.views.up = parseUpAxis(o.up);
   validateTrainingParams(p);
   return p;
 }
@@ -54,8 +56,13 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--hemisphere", opt->hemisphere, "Viewpoints on the upper hemisphere or the full sphere")
       ->check(CLI::IsMember({"upper", "full"}))
       ->capture_default_str();
+  sub->add_option("--up", opt->up,
+                  "The object's up axis in the mesh's frame: auto (the end it stands on, +z first), or +x, -x, +y, "
+                  "-y, +z, -z. Views are sampled above it and image up follows it")
+      ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}))
+      ->capture_default_str();
   sub->add_option("--max-view-angle", opt->max_view_angle,
-                  "Keep only viewpoints within this angle of the object's +z, degrees (e.g. 40 for parts that stand "
+                  "Keep only viewpoints within this angle of the object's up axis, degrees (e.g. 40 for parts that stand "
                   "upright under a camera looking down)")
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str();
@@ -66,7 +73,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--symmetric", opt->symmetric, "The object is symmetric (evaluation scores it with ADI)");
   sub->add_flag("--force", opt->force, "Overwrite --out if it exists");
   return [opt, &global]() {
-    const TrainingParams params = trainingParamsFrom(*opt);
+    TrainingParams params = trainingParamsFrom(*opt);
     if (std::filesystem::exists(opt->out) && !opt->force)
       throw InputError(fmt::format("{} exists: pass --force to overwrite it", opt->out));
     MeshLoadReport report;
@@ -79,11 +86,24 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                    unitName(report.units), report.file_diameter);
       fmt::print("diameter: {:.4f} m\n", mesh.diameter);
     }
+    if (opt->up == "auto") {
+      const UpAxisChoice up = findUpAxis(mesh);
+      params.views.up = up.up;
+      fmt::print("up axis: {} (auto: {})\n", upAxisName(up.up), up.reason);
+      if (global.verbose)
+        for (const RestingCandidate& c : up.candidates)
+          fmt::print("  {} up: base {:.0f}% of the footprint, {:.0f} degrees off the axis, centre of mass {:.1f} mm "
+                     "inside it{}\n",
+                     upAxisName(c.up), 100.f * c.support, c.tilt_deg, 1e3f * c.margin_m, c.stands() ? ", stands" : "");
+    } else {
+      fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
+    }
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);
     TrainingTimings timings;
     const std::vector<TrainingView> views =
-        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle);
+        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle,
+                   params.views.up);
     if (views.empty()) throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", opt->max_view_angle));
     const TemplateBank bank = trainTemplatesFromViews(
         ctx, mesh, params, views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);

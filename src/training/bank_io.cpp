@@ -2,6 +2,7 @@
 //   "VKPOSEBK"  u32 version  u32 reserved  u64 payload bytes  payload  u64 FNV-1a 64 of all before
 // The payload holds the object, its mesh (version 2: the pose stages render it, so a bank is
 // all detection needs), the training parameters and every template (see writePayload()).
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -157,6 +158,7 @@ void writeParams(Writer& w, const TrainingParams& p) {
   for (double v : {p.camera.fx, p.camera.fy, p.camera.cx, p.camera.cy, p.camera.depth_scale}) w.put(v);
   w.put(static_cast<int32_t>(p.camera.width));
   w.put(static_cast<int32_t>(p.camera.height));
+  for (int i = 0; i < 3; ++i) w.put(p.views.up[i]);  // version 3
 }
 
 void writePayload(Writer& w, const TemplateBank& bank) {
@@ -198,7 +200,7 @@ void writePayload(Writer& w, const TemplateBank& bank) {
   }
 }
 
-TemplateBank readPayload(Reader& r, const std::string& path) {
+TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
   TemplateBank bank;
   bank.object = r.getString();
   bank.mesh_hash = r.get<uint64_t>();
@@ -230,6 +232,10 @@ TemplateBank readPayload(Reader& r, const std::string& path) {
   p.camera.depth_scale = r.get<double>();
   p.camera.width = r.get<int32_t>();
   p.camera.height = r.get<int32_t>();
+  if (version >= 3) {
+    for (int i = 0; i < 3; ++i) p.views.up[i] = r.get<float>();
+    if (!p.views.up.allFinite() || std::abs(p.views.up.norm() - 1.f) > 1e-3f) r.fail("up axis is not a unit vector");
+  }  // version 2 banks were all trained about +z
   try {
     validateTrainingParams(p);
   } catch (const InputError& e) {
@@ -329,9 +335,9 @@ TemplateBank loadBank(const std::string& path) {
   }
   uint32_t version;
   std::memcpy(&version, bytes.data() + 8, 4);
-  if (version != kBankVersion)
-    throw InputError(fmt::format("{}: template bank version {}, this vkpose reads version {}: train it again", path,
-                                 version, kBankVersion));
+  if (version != kBankVersion && version != 2)
+    throw InputError(fmt::format("{}: template bank version {}, this vkpose reads versions 2 and {}: train it again",
+                                 path, version, kBankVersion));
   uint64_t payload_bytes;
   std::memcpy(&payload_bytes, bytes.data() + 16, 8);
   const uint64_t expected = kHeaderBytes + payload_bytes + 8;
@@ -345,7 +351,7 @@ TemplateBank loadBank(const std::string& path) {
   if (stored != fnv1a64(bytes.data(), expected - 8))
     throw InputError(fmt::format("{}: corrupt template bank (checksum mismatch)", path));
   Reader reader(bytes.data() + kHeaderBytes, payload_bytes, path);
-  return readPayload(reader, path);
+  return readPayload(reader, path, version);
 }
 
 uint64_t trainingKey(const Mesh& mesh, const TrainingParams& params, const std::vector<TrainingView>& views) {

@@ -59,7 +59,16 @@ void validateViewSampling(const ViewSamplingParams& p) {
   for (float a : p.inplane_deg.values())
     if (!(a >= -360.f && a <= 360.f))
       throw InputError(fmt::format("in-plane rotation {} degrees is outside -360 to 360", a));
+  if (!p.up.allFinite() || std::abs(p.up.norm() - 1.f) > 1e-3f)
+    throw InputError(fmt::format("up axis ({}, {}, {}) is not a unit vector", p.up.x(), p.up.y(), p.up.z()));
 }
+
+namespace {
+/// The rotation that turns +z into `up` (the sphere's pole into the object's up axis).
+Eigen::Matrix3f poleTo(const Eigen::Vector3f& up) {
+  return Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), up.normalized()).toRotationMatrix();
+}
+}  // namespace
 
 std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere) {
   // Fibonacci lattice: equal-area bands in z, golden-angle steps in azimuth. On the
@@ -78,10 +87,10 @@ std::vector<Eigen::Vector3f> sphereViewpoints(int count, bool full_sphere) {
 }
 
 TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f& centre, float distance,
-                        float inplane_deg) {
+                        float inplane_deg, const Eigen::Vector3f& object_up) {
   const Eigen::Vector3f z_cam = -direction.normalized();  // optical axis, in object coordinates
-  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
-  if (std::abs(z_cam.dot(up)) > 0.999f) up = Eigen::Vector3f::UnitY();
+  Eigen::Vector3f up = object_up.normalized();
+  if (std::abs(z_cam.dot(up)) > 0.999f) up = poleTo(object_up) * Eigen::Vector3f::UnitY();
   // Camera y points down in the image, so it is minus "up" made orthogonal to the axis.
   const Eigen::Vector3f y_cam = -(up - up.dot(z_cam) * z_cam).normalized();
   const Eigen::Vector3f x_cam = y_cam.cross(z_cam);
@@ -102,6 +111,7 @@ TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f&
 
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre) {
   validateViewSampling(params);
+  const Eigen::Matrix3f turn = poleTo(params.up);
   const auto dirs = sphereViewpoints(params.viewpoints, params.full_sphere);
   const auto radii = params.radii.values();
   const auto angles = params.inplane_deg.values();
@@ -110,7 +120,7 @@ std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Ei
   for (std::size_t i = 0; i < dirs.size(); ++i)
     for (float r : radii)
       for (float a : angles) {
-        auto v = lookAtView(dirs[i], centre, r, a);
+        auto v = lookAtView(turn * dirs[i], centre, r, a, params.up);
         v.viewpoint = static_cast<int>(i);
         views.push_back(v);
       }
@@ -118,14 +128,14 @@ std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Ei
 }
 
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
-                                     float max_polar_deg) {
+                                     float max_polar_deg, const Eigen::Vector3f& up) {
   if (!(max_polar_deg > 0.f && max_polar_deg <= 180.f))
     throw InputError(fmt::format("the largest angle from the top must be in (0, 180] degrees, not {}", max_polar_deg));
   const float min_cos = std::cos(max_polar_deg * std::numbers::pi_v<float> / 180.f);
   std::vector<TrainingView> out;
   for (const TrainingView& v : views) {
     const Eigen::Vector3f camera = -(v.R.transpose() * v.t);  // the camera's centre, object frame
-    if ((camera - centre).normalized().z() >= min_cos - 1e-6f) out.push_back(v);
+    if ((camera - centre).normalized().dot(up.normalized()) >= min_cos - 1e-6f) out.push_back(v);
   }
   return out;
 }
