@@ -319,5 +319,84 @@ TEST(SynthBadInput, ClearErrors) {
   fs::remove_all(dir);
 }
 
+TEST(SynthCloseRange, TheCameraDistanceIsAlongTheOpticalAxis) {
+  CameraRange range;
+  range.min_distance_m = 0.3f;
+  range.max_distance_m = 0.45f;
+  for (uint32_t seed = 0; seed < 50; ++seed) {
+    std::mt19937 rng(seed);
+    const Pose camera_T_world = randomCamera(range, rng);
+    // The point looked at lies on the table (z = 0) at the drawn distance along the axis.
+    const Pose world_T_camera = invert(camera_T_world);
+    const Eigen::Vector3f axis = world_T_camera.R.col(2), position = world_T_camera.t;
+    const float distance = -position.z() / axis.z();
+    EXPECT_GE(distance, 0.3f - 1e-4f) << seed;
+    EXPECT_LE(distance, 0.45f + 1e-4f) << seed;
+  }
+  // Without a distance range the height range holds, drawn as before.
+  std::mt19937 a(7), b(7);
+  CameraRange heights;
+  const Pose p = randomCamera(heights, a), q = randomCamera(heights, b);
+  EXPECT_TRUE(p.R.isApprox(q.R) && p.t.isApprox(q.t));
+  const float height = invert(p).t.z();
+  EXPECT_GE(height, heights.min_height_m - 1e-4f);
+  EXPECT_LE(height, heights.max_height_m + 1e-4f);
+}
+
+TEST(SynthCloseRange, BinsFitSmallPartsAndLeaveLargeOnesAlone) {
+  const Camera camera = tejaniCamera();
+  PlacementParams bin;
+  CameraRange close, far;
+  close.min_distance_m = 0.3f;
+  close.max_distance_m = 0.45f;
+  // LM-O-sized parts from 0.6 m and farther: the default bin, unchanged.
+  const PlacementParams same = fitBinToParts(bin, 0.15f, camera, far);
+  EXPECT_EQ(same.bin_inner_m, bin.bin_inner_m);
+  EXPECT_EQ(same.bin_wall_height_m, bin.bin_wall_height_m);
+  // A 40 mm part from 0.3 m: the bin fits the view (the 640x480 view there is 0.34 x 0.25 m)
+  // and its walls shrink with it.
+  const PlacementParams small = fitBinToParts(bin, 0.04f, camera, close);
+  EXPECT_LT(small.bin_inner_m.x(), 0.3f * 640.f / 571.f);
+  EXPECT_LT(small.bin_inner_m.y(), 0.3f * 480.f / 571.f);
+  EXPECT_GE(small.bin_inner_m.minCoeff(), 4 * 0.04f);
+  EXPECT_LT(small.bin_wall_height_m, bin.bin_wall_height_m);
+  EXPECT_GE(small.bin_wall_height_m, 0.04f);
+}
+
+TEST(SynthCloseRange, SmallPartsInABinSeenFromClose) {
+  SynthParams params;
+  params.meshes = {"unused"};
+  params.images = 1;
+  params.seed = 11;
+  params.min_instances = params.max_instances = 6;
+  params.placement.layout = Layout::Bin;
+  params.camera_range.min_distance_m = 0.3f;
+  params.camera_range.max_distance_m = 0.45f;
+  Mesh part = test::lShapeMesh();  // scaled to a 40 mm part
+  const float scale = 0.04f / part.diameter;
+  for (auto& v : part.vertices) v *= scale;
+  finishMesh(part);
+  const SynthImage image = synthesizeImage(test::context(), params, {part}, 0);
+  ASSERT_GE(image.poses.size(), 4u) << "the parts fit in the fitted bin";
+  int seen = 0;
+  for (const Pose& pose : image.poses) {
+    EXPECT_GT(pose.t.z(), 0.15f);
+    EXPECT_LT(pose.t.z(), 0.5f);
+    const Eigen::Vector2f px = image.camera.project(pose.t);
+    seen += px.x() >= 0 && px.y() >= 0 && px.x() < 640 && px.y() < 480;
+  }
+  EXPECT_GE(seen, 4) << "most parts are in view";
+  // Depth where the parts are: 15 to 50 cm.
+  double lo = 1e9, hi = 0;
+  cv::minMaxLoc(image.frame.depth_mm, &lo, &hi, nullptr, nullptr, image.frame.depth_mm > 0);
+  EXPECT_GT(lo, 100);
+  EXPECT_LT(hi, 800);
+  params.camera_range.min_distance_m = 0.05f;
+  EXPECT_THROW(validateSynthParams(params), InputError);
+  params.camera_range.min_distance_m = 0.3f;
+  params.placement.bin_inner_m = {0.f, 0.3f};
+  EXPECT_THROW(validateSynthParams(params), InputError);
+}
+
 }  // namespace
 }  // namespace vkpose

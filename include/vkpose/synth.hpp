@@ -63,6 +63,10 @@ struct PlacementParams {
 /// from the vertical (a camera over a workcell: 0.6 to 1.2 m, tilted up to 35 degrees).
 struct CameraRange {
   float min_height_m = 0.6f, max_height_m = 1.2f;
+  /// When max_distance_m > 0, the camera's distance along its optical axis to the point it
+  /// looks at is drawn from [min_distance_m, max_distance_m] instead of its height (the height
+  /// follows from the tilt): a bin-picking cell seeing small parts from 0.3-0.45 m.
+  float min_distance_m = 0.f, max_distance_m = 0.f;
   float max_tilt_deg = 35.f;
   float max_roll_deg = 10.f;  ///< turn about the optical axis either way
   float target_jitter_m = 0.05f;  ///< the point looked at is this far from the origin at most
@@ -89,6 +93,9 @@ struct SynthParams {
   Camera camera = tejaniCamera();
   DepthNoiseParams noise = synthNoise();
   PlacementParams placement;                ///< layout (table or bin) and its sizes
+  /// Bin layout: shrink the bin (inside and walls) to the parts and to what the camera sees
+  /// from its nearest distance (fitBinToParts); off: placement's sizes as they are.
+  bool fit_bin_to_parts = true;
   CameraRange camera_range;                 ///< random: where the camera may be
 };
 
@@ -96,6 +103,13 @@ struct SynthParams {
 /// clutter out of range, a --symmetric obj_id without a mesh, poses neither "random" nor a
 /// folder, the bin layout with pose files, a bad camera). Files are checked when read.
 void validateSynthParams(const SynthParams& params);
+
+/// A bin for parts of `diameter` metres (the largest) seen by `camera` from no nearer than
+/// `range` allows: at most `placement`'s size, at least four parts across, and filling about 70 %
+/// of the view there; the walls shrink with it (to 4 cm at the least). Sizes that fit already
+/// (the default bin from 0.6 m and farther) come back unchanged.
+PlacementParams fitBinToParts(const PlacementParams& placement, float diameter, const Camera& camera,
+                              const CameraRange& range);
 
 /// The pose files for each mesh, sorted by their number N (posesN.txt): `dir` itself when it
 /// holds pose files (one mesh only), otherwise the subfolder of `dir` named like each mesh's

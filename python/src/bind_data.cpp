@@ -1,5 +1,7 @@
 // Frames from files, synthetic datasets, evaluation and BOP results files.
+#include <algorithm>
 #include <filesystem>
+#include <sstream>
 
 #include <fmt/core.h>
 #include <pybind11/stl.h>
@@ -57,6 +59,41 @@ std::pair<int, int> countRange(const py::handle& value, const std::string& what)
   }
   const int n = whole(value);
   return {n, n};
+}
+
+/// Numbers of a (from, to) or (x, y[, h]) argument, `count` of them or `count_alt`.
+std::vector<float> metresOf(const py::handle& value, const std::string& what, std::size_t count, std::size_t count_alt) {
+  std::vector<float> out;
+  if (py::isinstance<py::str>(value)) {
+    std::string text = value.cast<std::string>();
+    std::replace(text.begin(), text.end(), ':', ' ');
+    std::istringstream in(text);
+    for (float v; in >> v;) out.push_back(v);
+  } else if (py::isinstance<py::sequence>(value)) {
+    for (const py::handle h : value) {
+      if (!py::isinstance<py::float_>(h) && !py::isinstance<py::int_>(h))
+        valueError(fmt::format("{}: expected numbers in metres, got {}", what, py::repr(value).cast<std::string>()));
+      out.push_back(h.cast<float>());
+    }
+  }
+  if (out.size() != count && out.size() != count_alt)
+    valueError(fmt::format("{}: expected {} numbers in metres, got {}", what, count, py::repr(value).cast<std::string>()));
+  return out;
+}
+
+void applyCloseRange(SynthParams& params, const py::object& camera_distance, const py::object& bin_size) {
+  if (!camera_distance.is_none()) {
+    const auto d = metresOf(camera_distance, "camera_distance", 2, 2);
+    params.camera_range.min_distance_m = d[0];
+    params.camera_range.max_distance_m = d[1];
+    if (!(d[1] > 0.f)) valueError("camera_distance: the largest distance must be positive");
+  }
+  if (!bin_size.is_none()) {
+    const auto b = metresOf(bin_size, "bin_size", 2, 3);
+    params.placement.bin_inner_m = {b[0], b[1]};
+    if (b.size() == 3) params.placement.bin_wall_height_m = b[2];
+    params.fit_bin_to_parts = false;
+  }
 }
 
 py::dict resultRow(const BopResult& r) {
@@ -138,9 +175,11 @@ void bindData(py::module_& m) {
       "synth",
       [](const py::object& meshes, const py::object& out, int images, const std::string& poses,
          const std::string& layout, uint32_t seed, const py::object& instances, int clutter,
-         const std::vector<int>& symmetric, const std::string& units, const py::object& camera, bool overwrite,
-         const py::object& device, const py::object& progress) {
+         const std::vector<int>& symmetric, const std::string& units, const py::object& camera,
+         const py::object& camera_distance, const py::object& bin_size, bool overwrite, const py::object& device,
+         const py::object& progress) {
         SynthParams params;
+        applyCloseRange(params, camera_distance, bin_size);
         params.meshes = pathsOf(meshes, "meshes");
         params.images = images;
         params.poses = poses;
@@ -178,20 +217,25 @@ void bindData(py::module_& m) {
       py::arg("meshes"), py::arg("out"), py::kw_only(), py::arg("images"), py::arg("poses") = "random",
       py::arg("layout") = "table", py::arg("seed") = 0, py::arg("instances") = "1:3", py::arg("clutter") = 4,
       py::arg("symmetric") = std::vector<int>{}, py::arg("units") = "auto", py::arg("camera") = py::none(),
-      py::arg("overwrite") = false, py::arg("device") = py::none(), py::arg("progress") = py::none(),
+      py::arg("camera_distance") = py::none(), py::arg("bin_size") = py::none(), py::arg("overwrite") = false, py::arg("device") = py::none(), py::arg("progress") = py::none(),
       R"(Renders a synthetic multi-instance RGB-D dataset in BOP format into `out`, as `vkpose synth`
 does: the same arguments and seed give the same files. Returns a summary dict (dataset, images,
 instances, left_out, ms_per_image); vkpose.evaluate() scores a method on it.
 
 meshes: one path or a list (obj_id 1, 2, ...). poses: 'random' or a folder of Tejani et al.
 pose files. layout: 'table' or 'bin'. instances: of each mesh per image, N or "MIN:MAX".
-clutter: boxes and cylinders not in the ground truth. symmetric: obj_ids scored with ADI.)");
+clutter: boxes and cylinders not in the ground truth. symmetric: obj_ids scored with ADI.
+camera_distance: (from, to) metres from the camera to the point it looks at (default: its
+height, 0.6 to 1.2 m). bin_size: (x, y) or (x, y, wall height) metres (default: fitted to the
+parts and the view).)");
 
   m.def(
       "synth_frame",
       [](const py::object& meshes, int index, uint32_t seed, const std::string& layout, const py::object& instances,
-         int clutter, const std::string& units, const py::object& device) {
+         int clutter, const std::string& units, const py::object& camera_distance, const py::object& bin_size,
+         const py::object& device) {
         SynthParams params;
+        applyCloseRange(params, camera_distance, bin_size);
         params.meshes = pathsOf(meshes, "meshes");
         params.images = index + 1;
         params.seed = seed;
@@ -228,7 +272,8 @@ clutter: boxes and cylinders not in the ground truth. symmetric: obj_ids scored 
         return out;
       },
       py::arg("meshes"), py::kw_only(), py::arg("index") = 0, py::arg("seed") = 0, py::arg("layout") = "table",
-      py::arg("instances") = "1:3", py::arg("clutter") = 4, py::arg("units") = "auto", py::arg("device") = py::none(),
+      py::arg("instances") = "1:3", py::arg("clutter") = 4, py::arg("units") = "auto",
+      py::arg("camera_distance") = py::none(), py::arg("bin_size") = py::none(), py::arg("device") = py::none(),
       "One random synthetic frame in memory, image `index` of what synth() would write with these arguments: a dict "
       "with rgb (BGR uint8), depth (uint16 mm), camera (a Camera) and gt (obj_id, R, t per instance).");
 

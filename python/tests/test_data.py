@@ -99,3 +99,17 @@ def test_detect_folder_example(icbin, icbin_bank, tmp_path):
     rows = vkpose.read_bop_results(out / "results.csv")
     assert rows and {r["im_id"] for r in rows} == {0, 1} and {r["obj_id"] for r in rows} == {1}
     assert (out / "0000.png").exists() and (out / "0001.png").exists()
+
+
+def test_small_parts_in_a_bin_from_close_by():
+    frame = vkpose.synth_frame(BRACKET, layout="bin", instances=4, camera_distance=(0.3, 0.45), seed=2, units="mm")
+    depth = frame["depth"][frame["depth"] > 0]
+    assert frame["gt"] and depth.min() > 100 and np.median(depth) < 600
+    for g in frame["gt"]:
+        assert 0.15 < g["t"][2] < 0.6
+    with pytest.raises(ValueError, match="camera_distance"):
+        vkpose.synth_frame(BRACKET, camera_distance=(0.3,), units="mm")
+    with pytest.raises(ValueError, match="camera distance"):
+        vkpose.synth_frame(BRACKET, camera_distance="0.45:0.3", units="mm")
+    with pytest.raises(ValueError, match="bin"):
+        vkpose.synth_frame(BRACKET, layout="bin", bin_size=(0.0, 0.2), units="mm")

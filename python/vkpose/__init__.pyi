@@ -246,11 +246,14 @@ def read_bop_results(path: PathLike) -> list[dict[str, Any]]:
 def synth(meshes: PathLike | Sequence[PathLike], out: PathLike, *, images: int, poses: str = "random",
           layout: str = "table", seed: int = 0, instances: str | int | tuple[int, int] = "1:3", clutter: int = 4,
           symmetric: Sequence[int] = ..., units: str = "auto", camera: CameraArg | None = None,
-          overwrite: bool = False, device: DeviceArg = None, progress: Progress = None) -> dict[str, Any]:
+          camera_distance: str | tuple[float, float] | None = None,
+          bin_size: str | tuple[float, float] | tuple[float, float, float] | None = None, overwrite: bool = False, device: DeviceArg = None, progress: Progress = None) -> dict[str, Any]:
     """Renders a synthetic BOP dataset into out; returns a summary."""
 
 def synth_frame(meshes: PathLike | Sequence[PathLike], *, index: int = 0, seed: int = 0, layout: str = "table",
                 instances: str | int | tuple[int, int] = "1:3", clutter: int = 4, units: str = "auto",
+                camera_distance: str | tuple[float, float] | None = None,
+                bin_size: str | tuple[float, float] | tuple[float, float, float] | None = None,
                 device: DeviceArg = None) -> dict[str, Any]:
     """One random synthetic frame in memory: rgb, depth, camera, gt."""
 

@@ -1,6 +1,7 @@
 // `vkpose synth --mesh MESH ... --poses DIR|random --images N --seed S --out DIR`: a synthetic
 // multi-instance BOP dataset (include/vkpose/synth.hpp does the work).
 #include <charconv>
+#include <cmath>
 
 #include <fmt/core.h>
 
@@ -15,7 +16,7 @@ using util::ProgressBar;
 
 namespace {
 struct SynthOptions {
-  std::string units = "auto", layout = "table", instances = "1:3", camera, out;
+  std::string units = "auto", layout = "table", instances = "1:3", camera, out, camera_distance, bin_size;
   bool force = false;
   SynthParams params;
 };
@@ -36,6 +37,28 @@ std::pair<int, int> parseRange(const std::string& text) {
     return {n, n};
   }
   return {toInt(text.substr(0, colon), "--instances"), toInt(text.substr(colon + 1), "--instances")};
+}
+
+/// "A:B" or "A:B:C", metres; `what` names the flag.
+std::vector<float> parseMetres(const std::string& text, const char* what, std::size_t min_count, std::size_t max_count) {
+  std::vector<float> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t colon = text.find(':', start);
+    const std::string part = text.substr(start, colon == std::string::npos ? std::string::npos : colon - start);
+    float v = 0.f;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
+      throw InputError(fmt::format("{} '{}': expected numbers in metres separated by ':'", what, text));
+    out.push_back(v);
+    if (colon == std::string::npos) break;
+    start = colon + 1;
+  }
+  if (out.size() < min_count || out.size() > max_count)
+    throw InputError(fmt::format("{} '{}': expected {} numbers", what, text,
+                                 min_count == max_count ? std::to_string(min_count)
+                                                        : fmt::format("{} or {}", min_count, max_count)));
+  return out;
 }
 
 const char* unitName(MeshUnits u) { return u == MeshUnits::Millimetres ? "mm" : "m"; }
@@ -68,6 +91,12 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--clutter", p.clutter, "Boxes and cylinders per image that are not in the ground truth")
       ->capture_default_str();
+  sub->add_option("--camera-distance", opt->camera_distance,
+                  "random: the camera's distance to the point it looks at, FROM:TO metres (e.g. 0.3:0.45 for small "
+                  "parts); default: its height above the table, 0.6 to 1.2 m");
+  sub->add_option("--bin-size", opt->bin_size,
+                  "bin layout: inside X:Y (metres) and optionally the wall height X:Y:H; default: 0.40:0.30:0.15, "
+                  "made smaller for small parts seen from close by");
   sub->add_option("--symmetric", p.symmetric,
                   "obj_id of a mesh with a continuous symmetry about its z axis (models_info.json's "
                   "symmetries_continuous, so ADI scores it); repeat for several");
@@ -79,6 +108,17 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     params.placement.layout = opt->layout == "bin" ? Layout::Bin : Layout::Table;
     std::tie(params.min_instances, params.max_instances) = parseRange(opt->instances);
     if (!opt->camera.empty()) params.camera = loadCamera(opt->camera);
+    if (!opt->camera_distance.empty()) {
+      const auto d = parseMetres(opt->camera_distance, "--camera-distance", 2, 2);
+      params.camera_range.min_distance_m = d[0];
+      params.camera_range.max_distance_m = d[1];
+    }
+    if (!opt->bin_size.empty()) {
+      const auto b = parseMetres(opt->bin_size, "--bin-size", 2, 3);
+      params.placement.bin_inner_m = {b[0], b[1]};
+      if (b.size() == 3) params.placement.bin_wall_height_m = b[2];
+      params.fit_bin_to_parts = false;
+    }
     validateSynthParams(params);  // bad input is exit 1 even on a machine without a device
     GpuContext ctx(global.gpu());
     ProgressBar bar("rendering", global.quiet);

@@ -61,6 +61,7 @@ SynthParams binScenes(const DemoParams& params, const std::vector<std::string>& 
   s.placement.upright_only = true;
   s.placement.bin_max_tilt_deg = 6.f;
   s.placement.bin_inner_m = {0.46f, 0.36f};
+  s.fit_bin_to_parts = false;  // the demo's own bin
   s.camera_range.min_height_m = 0.75f;
   s.camera_range.max_height_m = 0.85f;
   s.camera_range.max_tilt_deg = 12.f;

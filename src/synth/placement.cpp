@@ -200,8 +200,13 @@ Pose lookDownAt(const Eigen::Vector3f& target, float height_m, float tilt_rad, f
 }
 
 Pose randomCamera(const CameraRange& range, std::mt19937& rng) {
-  const float height = uniform(rng, range.min_height_m, range.max_height_m);
+  // The same draws in the same order either way, so that datasets made before the distance
+  // range existed come out as they did.
+  const bool by_distance = range.max_distance_m > 0.f;
+  const float drawn = by_distance ? uniform(rng, range.min_distance_m, range.max_distance_m)
+                                  : uniform(rng, range.min_height_m, range.max_height_m);
   const float tilt = radians(uniform(rng, 0.f, range.max_tilt_deg));
+  const float height = by_distance ? drawn * std::cos(tilt) : drawn;
   const float azimuth = uniform(rng, 0.f, 2.f * kPi);
   const float roll = radians(uniform(rng, -range.max_roll_deg, range.max_roll_deg));
   const Eigen::Vector3f target(uniform(rng, -1.f, 1.f) * range.target_jitter_m,

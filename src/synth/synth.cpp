@@ -122,19 +122,24 @@ void addTable(ImageScene& s, const Camera& camera, float z, std::mt19937& rng) {
   s.add(std::move(table), at);
 }
 
-/// A box or a cylinder of a random size and colour: things on a table that are not the objects.
-Mesh clutterMesh(std::mt19937& rng) {
+/// A box or a cylinder of a random size and colour: things on a table that are not the objects,
+/// `scale` times the size of things that stand among 10-30 cm objects.
+Mesh clutterMesh(std::mt19937& rng, float scale) {
   const Eigen::Vector3f colour = randomColour(rng, 0.1f, 0.9f);
   if (rng() % 2)
-    return cuboidMesh({uniform(rng, 0.03f, 0.14f), uniform(rng, 0.03f, 0.14f), uniform(rng, 0.02f, 0.12f)}, colour);
-  return cylinderMesh(uniform(rng, 0.02f, 0.05f), uniform(rng, 0.04f, 0.15f), colour);
+    // Braces: the three draws in order, as before there was a scale.
+    return cuboidMesh(
+        scale * Eigen::Vector3f{uniform(rng, 0.03f, 0.14f), uniform(rng, 0.03f, 0.14f), uniform(rng, 0.02f, 0.12f)},
+        colour);
+  // The same expression shape as before there was a scale, so the compiler draws in the same order.
+  return cylinderMesh(scale * uniform(rng, 0.02f, 0.05f), scale * uniform(rng, 0.04f, 0.15f), colour);
 }
 
 /// Places clutter clear of `obstacles`, and adds it to the scene.
 void addClutter(ImageScene& s, const SynthParams& p, const PlacementParams& placement,
-                const std::vector<OrientedBox>& obstacles, std::mt19937& rng) {
+                const std::vector<OrientedBox>& obstacles, float scale, std::mt19937& rng) {
   std::vector<Mesh> meshes;
-  for (int i = 0; i < p.clutter; ++i) meshes.push_back(clutterMesh(rng));
+  for (int i = 0; i < p.clutter; ++i) meshes.push_back(clutterMesh(rng, scale));
   std::vector<const Mesh*> pointers;
   for (const auto& m : meshes) pointers.push_back(&m);
   const auto poses = placeObjects(pointers, obstacles, placement, p.camera, s.camera_T_world, rng);
@@ -144,16 +149,21 @@ void addClutter(ImageScene& s, const SynthParams& p, const PlacementParams& plac
 
 ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, std::mt19937& rng) {
   ImageScene s;
+  float diameter = 0.f;  // of the largest part
+  for (const Mesh& m : models) diameter = std::max(diameter, m.diameter);
+  PlacementParams placement = p.placement;
+  if (p.placement.layout == Layout::Bin && p.fit_bin_to_parts)
+    placement = fitBinToParts(p.placement, diameter, p.camera, p.camera_range);
   s.camera_T_world = randomCamera(p.camera_range, rng);
   std::vector<OrientedBox> obstacles;
-  if (p.placement.layout == Layout::Bin) obstacles = binWalls(p.placement);
+  if (placement.layout == Layout::Bin) obstacles = binWalls(placement);
   std::vector<int> order;  // model indices, shuffled so no object is always placed first
   for (std::size_t m = 0; m < models.size(); ++m)
     for (int k = uniformInt(rng, p.min_instances, p.max_instances); k > 0; --k) order.push_back(static_cast<int>(m));
   for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng() % i]);
   std::vector<const Mesh*> meshes;
   for (const int m : order) meshes.push_back(&models[static_cast<std::size_t>(m)]);
-  const auto poses = placeObjects(meshes, obstacles, p.placement, p.camera, s.camera_T_world, rng);
+  const auto poses = placeObjects(meshes, obstacles, placement, p.camera, s.camera_T_world, rng);
   for (std::size_t i = 0; i < poses.size(); ++i) {
     if (!poses[i]) {
       ++s.left_out;
@@ -163,18 +173,19 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
     s.obj_ids.push_back(order[i] + 1);
     obstacles.push_back(orientedBox(*meshes[i], *poses[i]));
   }
-  addClutter(s, p, p.placement, obstacles, rng);
-  if (p.placement.layout == Layout::Bin) {
+  // Clutter no larger than the parts when they are small (below 10 cm, where it used to dwarf them).
+  addClutter(s, p, placement, obstacles, std::min(1.f, diameter / 0.1f), rng);
+  if (placement.layout == Layout::Bin) {
     const Eigen::Vector3f colour = randomColour(rng, 0.2f, 0.7f);
-    for (const OrientedBox& wall : binWalls(p.placement)) {
+    for (const OrientedBox& wall : binWalls(placement)) {
       Pose at;
       at.t = wall.centre;
       s.add(cuboidMesh(2.f * wall.half, colour), at);
     }
-    const float floor = p.placement.bin_wall_thickness_m;
+    const float floor = placement.bin_wall_thickness_m;
     Pose at;
     at.t.z() = -0.5f * floor;
-    s.add(cuboidMesh({p.placement.bin_inner_m.x() + 2 * floor, p.placement.bin_inner_m.y() + 2 * floor, floor}, colour),
+    s.add(cuboidMesh({placement.bin_inner_m.x() + 2 * floor, placement.bin_inner_m.y() + 2 * floor, floor}, colour),
           at);
     addTable(s, p.camera, -floor - 0.001f, rng);
   } else {
@@ -198,7 +209,7 @@ ImageScene tejaniScene(const SynthParams& p, const Mesh& model, int obj_id, cons
   }
   PlacementParams table = p.placement;
   table.layout = Layout::Table;
-  addClutter(s, p, table, obstacles, rng);
+  addClutter(s, p, table, obstacles, std::min(1.f, model.diameter / 0.1f), rng);
   addTable(s, p.camera, 0.f, rng);
   return s;
 }
@@ -293,6 +304,20 @@ RenderedImage renderImage(const GpuContext& ctx, const SynthParams& p, const std
 
 }  // namespace
 
+PlacementParams fitBinToParts(const PlacementParams& placement, float diameter, const Camera& camera,
+                              const CameraRange& range) {
+  const float nearest = range.max_distance_m > 0.f ? range.min_distance_m : range.min_height_m;
+  const Eigen::Vector2f view(nearest * static_cast<float>(camera.width / camera.fx),
+                             nearest * static_cast<float>(camera.height / camera.fy));
+  PlacementParams out = placement;
+  for (int i = 0; i < 2; ++i)
+    out.bin_inner_m[i] = std::min(placement.bin_inner_m[i], std::max(4.f * diameter, 0.7f * view[i]));
+  // Walls shrink with the bin, to 4 cm at the least.
+  const float scale = std::min(out.bin_inner_m.x() / placement.bin_inner_m.x(), out.bin_inner_m.y() / placement.bin_inner_m.y());
+  if (scale < 1.f) out.bin_wall_height_m = std::max(std::min(0.04f, placement.bin_wall_height_m), scale * placement.bin_wall_height_m);
+  return out;
+}
+
 void validateSynthParams(const SynthParams& p) {
   if (p.meshes.empty()) throw InputError("synth needs at least one mesh");
   if (p.images < 1) throw InputError(fmt::format("--images must be 1 or more, not {}", p.images));
@@ -311,6 +336,16 @@ void validateSynthParams(const SynthParams& p) {
       throw InputError("the bin layout places objects itself: use it with --poses random");
   }
   validateCamera(p.camera, "synth camera");
+  const CameraRange& c = p.camera_range;
+  if (c.max_distance_m > 0.f && !(c.min_distance_m >= 0.1f && c.min_distance_m <= c.max_distance_m &&
+                                  c.max_distance_m <= 5.f))
+    throw InputError(fmt::format("camera distance {}:{} m: need 0.1 <= FROM <= TO <= 5", c.min_distance_m,
+                                 c.max_distance_m));
+  const PlacementParams& b = p.placement;
+  if (!(b.bin_inner_m.x() >= 0.02f && b.bin_inner_m.y() >= 0.02f && b.bin_inner_m.maxCoeff() <= 3.f &&
+        b.bin_wall_height_m >= 0.f && b.bin_wall_height_m <= 1.f))
+    throw InputError(fmt::format("bin {} x {} m, walls {} m: need sides of 0.02 to 3 m and walls of 0 to 1 m",
+                                 b.bin_inner_m.x(), b.bin_inner_m.y(), b.bin_wall_height_m));
 }
 
 std::vector<std::vector<std::string>> tejaniPoseFiles(const std::string& dir,
