@@ -466,3 +466,34 @@ TEST(Metrics, BopCsvLinesAreBopToolkits) {
 
 }  // namespace
 }  // namespace vkpose
+
+namespace vkpose {
+namespace {
+
+TEST(PrecisionRecall, OnePointPerScoreFromTheTopIgnoredLeftOut) {
+  const std::vector<ScoredOutcome> outcomes{{1, 0.9f, true, false},  {1, 0.8f, false, false}, {1, 0.7f, true, false},
+                                            {1, 0.7f, false, false}, {1, 0.4f, true, false},  {1, 0.3f, true, true},
+                                            {2, 0.95f, false, false}};
+  const auto curve = precisionRecallCurve(outcomes, 4, 1);
+  ASSERT_EQ(curve.size(), 4u);
+  EXPECT_FLOAT_EQ(curve[0].threshold, 0.9f);
+  EXPECT_DOUBLE_EQ(curve[0].scores.precision, 1.0);
+  EXPECT_DOUBLE_EQ(curve[0].scores.recall, 0.25);
+  EXPECT_DOUBLE_EQ(curve[1].scores.precision, 0.5);
+  // Both estimates of score 0.7 are in the third point.
+  EXPECT_FLOAT_EQ(curve[2].threshold, 0.7f);
+  EXPECT_EQ(curve[2].scores.tp, 2);
+  EXPECT_EQ(curve[2].scores.fp, 2);
+  EXPECT_EQ(curve[2].scores.fn, 2);
+  EXPECT_DOUBLE_EQ(curve[3].scores.precision, 0.6);
+  EXPECT_DOUBLE_EQ(curve[3].scores.recall, 0.75);
+  // All objects: object 2's false positive comes first.
+  const auto all = precisionRecallCurve(outcomes, 5);
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_DOUBLE_EQ(all[0].scores.precision, 0.0);
+  EXPECT_EQ(all.back().scores.fp, 3);
+  EXPECT_TRUE(precisionRecallCurve({}, 3).empty());
+}
+
+}  // namespace
+}  // namespace vkpose

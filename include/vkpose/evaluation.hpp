@@ -365,6 +365,27 @@ struct EvalRunParams {
   std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> on_detections;
 };
 
+/// What became of one estimate in the one-to-one matching, with its score: for the
+/// precision-recall curve.
+struct ScoredOutcome {
+  int obj_id = 0;
+  float score = 0.f;
+  bool correct = false;  ///< matched an instance (a true positive)
+  bool ignored = false;  ///< matched an instance below min_visib_fract: neither TP nor FP
+};
+
+/// One point of a precision-recall curve: the scores of the estimates whose score is at least
+/// `threshold`. The matching is greedy by score, so dropping the estimates below a threshold
+/// leaves the matches of those above it as they were.
+struct PrPoint {
+  float threshold = 0.f;
+  ObjectScores scores;
+};
+
+/// The curve of `outcomes` against `instances` counted ground-truth instances (of obj_id, or of
+/// every object for obj_id 0), one point per distinct score, highest first.
+std::vector<PrPoint> precisionRecallCurve(const std::vector<ScoredOutcome>& outcomes, int instances, int obj_id = 0);
+
 /// One method's scores and times.
 struct MethodEvaluation {
   EvalMethod method = EvalMethod::Vkpose;
@@ -379,6 +400,7 @@ struct MethodEvaluation {
   /// linemod find all objects in one pass, so each object's figure is the whole pass.
   std::map<int, double> object_ms_per_image;
   std::vector<BopResult> results;  ///< every estimate, for the BOP CSV
+  std::vector<ScoredOutcome> outcomes;  ///< every estimate's outcome, for precisionRecallCurve
 };
 
 struct EvalReport {
@@ -410,6 +432,10 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
 ///                                           "tp", "fp", "fn"}, ...}}, ...},
 ///  "dataset": ..., "split": ..., "images": N, "device": ...}
 std::string evalReportJson(const EvalReport& report);
+
+/// The precision-recall curves of a report as CSV: `method,obj_id,threshold,precision,recall,f1,
+/// tp,fp,fn`, a curve per method for all objects together (obj_id 0) and per object.
+std::string precisionRecallCsv(const EvalReport& report);
 
 /// The side-by-side table: a row per object and method, then each method's average.
 std::string evalReportTable(const EvalReport& report);

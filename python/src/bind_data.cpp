@@ -281,8 +281,8 @@ parts and the view).)");
       "evaluate",
       [](const py::object& dataset, const py::dict& banks, const std::vector<std::string>& methods,
          const std::string& split, const py::object& config, int images, float k_m, float min_visib,
-         const py::object& out, const py::object& report, bool overwrite, const py::object& device,
-         const py::object& progress) {
+         const py::object& out, const py::object& report, const py::object& pr_curve, bool overwrite,
+         const py::object& device, const py::object& progress) {
         EvalRunParams params;
         params.detector = paramsOf(config);
         params.linemod.match = params.detector.match;
@@ -296,7 +296,9 @@ parts and the view).)");
         const std::string root = pathOf(dataset, "dataset");
         const std::string out_path = out.is_none() ? "" : pathOf(out, "out");
         const std::string report_path = report.is_none() ? "" : pathOf(report, "report");
+        const std::string pr_path = pr_curve.is_none() ? "" : pathOf(pr_curve, "pr_curve");
         if (!report_path.empty()) refuseOverwrite(report_path, overwrite);
+        if (!pr_path.empty()) refuseOverwrite(pr_path, overwrite);
         if (!out_path.empty())
           for (EvalMethod method : params.methods) refuseOverwrite(methodResultsPath(out_path, method), overwrite);
         if (!std::filesystem::is_directory(root)) valueError(root + ": no such dataset folder");
@@ -318,6 +320,7 @@ parts and the view).)");
           r = runEvaluation(dev->context, data, bank_map, params, step);
         }
         if (!report_path.empty()) writeTextFile(report_path, evalReportJson(r), true);
+        if (!pr_path.empty()) writeTextFile(pr_path, precisionRecallCsv(r), true);
         if (!out_path.empty())
           for (const MethodEvaluation& me : r.methods) saveBopResults(methodResultsPath(out_path, me.method), me.results);
         py::dict doc = py::module_::import("json").attr("loads")(evalReportJson(r));
@@ -334,7 +337,8 @@ parts and the view).)");
       py::arg("dataset"), py::arg("banks"), py::kw_only(),
       py::arg("methods") = std::vector<std::string>{"vkpose", "linemod", "ppf"}, py::arg("split") = "test",
       py::arg("config") = py::none(), py::arg("images") = 0, py::arg("k_m") = 0.15f, py::arg("min_visib") = 0.f,
-      py::arg("out") = py::none(), py::arg("report") = py::none(), py::arg("overwrite") = false,
+      py::arg("out") = py::none(), py::arg("report") = py::none(), py::arg("pr_curve") = py::none(),
+      py::arg("overwrite") = false,
       py::arg("device") = py::none(), py::arg("progress") = py::none(),
       R"(Scores vkpose and the paper's baselines side by side on a BOP dataset, as `vkpose eval` does.
 Returns the report `vkpose eval --report` writes, as a dict ({"methods": {name: {"average": ...,
@@ -344,7 +348,8 @@ read_bop_results gives them} and "warnings".
 banks: {obj_id: Bank or bank path}. methods: any of 'vkpose', 'linemod', 'ppf'. config: the
 detector's stage parameters (as Detector takes them). images: the first N (0: all). k_m: an
 estimate is correct below k_m * diameter. out: BOP results CSV, METHOD_ put before the file
-name; report: the JSON report.)");
+name; report: the JSON report; pr_curve: the precision-recall curves CSV (`vkpose eval
+--pr-curve`).)");
 }
 
 }  // namespace vkpose::python

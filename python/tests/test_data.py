@@ -47,7 +47,8 @@ def test_synth_and_evaluate_equal_the_cli(bracket_bank, cli, tmp_path):
     bank_path = tmp_path / "bracket.vkpb"
     bracket_bank.save(bank_path)
     report = vkpose.evaluate(tmp_path / "py", {1: bracket_bank}, methods=["vkpose"], out=tmp_path / "r.csv",
-                             report=tmp_path / "report.json")
+                             report=tmp_path / "report.json", pr_curve=tmp_path / "pr.csv")
+    assert (tmp_path / "pr.csv").read_text().startswith("method,obj_id,threshold,precision,recall,f1,tp,fp,fn")
     assert set(report["methods"]) == {"vkpose"} and report["images"] == 2
     scores = report["methods"]["vkpose"]["objects"]["1"]
     assert scores["tp"] + scores["fn"] == 2

@@ -260,5 +260,5 @@ def synth_frame(meshes: PathLike | Sequence[PathLike], *, index: int = 0, seed: 
 def evaluate(dataset: PathLike, banks: Mapping[int, Bank | PathLike], *, methods: Sequence[str] = ...,
              split: str = "test", config: ConfigArg = None, images: int = 0, k_m: float = 0.15,
              min_visib: float = 0.0, out: PathLike | None = None, report: PathLike | None = None,
-             overwrite: bool = False, device: DeviceArg = None, progress: Progress = None) -> dict[str, Any]:
+             pr_curve: PathLike | None = None, overwrite: bool = False, device: DeviceArg = None, progress: Progress = None) -> dict[str, Any]:
     """Scores vkpose and the baselines on a BOP dataset; returns the report as a dict."""

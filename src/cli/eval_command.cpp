@@ -18,7 +18,7 @@ using util::ProgressBar;
 
 namespace {
 struct EvalOptions {
-  std::string dataset, split = "test", out, report, config;
+  std::string dataset, split = "test", out, report, config, pr_curve;
   std::vector<std::string> banks, methods;
   bool force = false;
   EvalRunParams params;
@@ -62,6 +62,9 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
                   "BOP results CSV, one per method: METHOD_ is put before the file name (--out r/lmo-test.csv writes "
                   "r/vkpose_lmo-test.csv, ...)");
   sub->add_option("--report", opt->report, "JSON report to write (per method: average and per-object scores)");
+  sub->add_option("--pr-curve", opt->pr_curve,
+                  "Precision-recall curves CSV to write (per method, all objects and each object: precision, recall "
+                  "and F1 of the estimates scoring at least each threshold)");
   sub->add_option("--images", p.max_images, "Evaluate the first N images only (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -112,6 +115,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
     // Nothing is computed before every output is known to be writable.
     std::vector<std::string> outputs;
     if (!opt->report.empty()) outputs.push_back(opt->report);
+    if (!opt->pr_curve.empty()) outputs.push_back(opt->pr_curve);
     if (!opt->out.empty())
       for (EvalMethod m : params.methods) outputs.push_back(methodResultsPath(opt->out, m));
     for (const auto& path : outputs) {
@@ -143,6 +147,25 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
     if (!opt->report.empty()) {
       writeTextFile(opt->report, evalReportJson(report), opt->force);
       if (!global.quiet) fmt::print("wrote {}\n", opt->report);
+    }
+    if (!opt->pr_curve.empty()) {
+      writeTextFile(opt->pr_curve, precisionRecallCsv(report), opt->force);
+      for (const MethodEvaluation& m : report.methods) {
+        const auto curve = precisionRecallCurve(m.outcomes, m.summary.total.tp + m.summary.total.fn);
+        const PrPoint* at_half = nullptr;
+        const PrPoint* best = nullptr;
+        for (const PrPoint& pt : curve) {
+          if (pt.threshold >= 0.5f) at_half = &pt;
+          if (!best || pt.scores.f1 > best->scores.f1) best = &pt;
+        }
+        if (!best) continue;
+        fmt::print("{}: {}best F1 {:.3f} at score >= {:.3g}\n", methodName(m.method),
+                   at_half ? fmt::format("score >= 0.5: precision {:.3f}, recall {:.3f}; ", at_half->scores.precision,
+                                         at_half->scores.recall)
+                           : std::string("no estimate scores 0.5; "),
+                   best->scores.f1, best->threshold);
+      }
+      if (!global.quiet) fmt::print("wrote {}\n", opt->pr_curve);
     }
     if (!opt->out.empty())
       for (const MethodEvaluation& m : report.methods) {

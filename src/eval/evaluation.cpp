@@ -34,6 +34,7 @@ struct MethodRun {
   double total_ms = 0;
   std::map<int, double> object_ms;
   std::vector<BopResult> results;
+  std::vector<ScoredOutcome> outcomes;
 };
 }  // namespace
 
@@ -152,6 +153,9 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
       try {
         const ImageEvaluation evaluation = evaluateImage(estimates, gt, models, params.eval);
         for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
+        for (std::size_t e = 0; e < estimates.size(); ++e)
+          run.outcomes.push_back({estimates[e].obj_id, estimates[e].score, evaluation.matches[e].gt >= 0,
+                                  evaluation.matches[e].ignored});
       } catch (const InputError& e) {
         throw InputError(fmt::format("{} on scene {} image {}: {}", methodName(run.method), im.scene_id, im.image_id,
                                      e.what()));
@@ -169,10 +173,42 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
     m.ms_per_image = run.total_ms / static_cast<double>(n_images);
     for (const auto& [obj_id, ms] : run.object_ms) m.object_ms_per_image[obj_id] = ms / static_cast<double>(n_images);
     m.results = std::move(run.results);
+    m.outcomes = std::move(run.outcomes);
     report.methods.push_back(std::move(m));
   }
   report.warnings.assign(warnings.begin(), warnings.end());
   return report;
+}
+
+std::vector<PrPoint> precisionRecallCurve(const std::vector<ScoredOutcome>& outcomes, int instances, int obj_id) {
+  std::vector<const ScoredOutcome*> sorted;
+  for (const ScoredOutcome& o : outcomes)
+    if ((obj_id == 0 || o.obj_id == obj_id) && !o.ignored) sorted.push_back(&o);
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) { return a->score > b->score; });
+  std::vector<PrPoint> curve;
+  EvalCounts c;
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    (sorted[i]->correct ? c.tp : c.fp) += 1;
+    if (i + 1 < sorted.size() && sorted[i + 1]->score == sorted[i]->score) continue;  // one point per score
+    EvalCounts at = c;
+    at.fn = std::max(0, instances - c.tp);
+    curve.push_back({sorted[i]->score, scoresOf(at)});
+  }
+  return curve;
+}
+
+std::string precisionRecallCsv(const EvalReport& report) {
+  std::string out = "method,obj_id,threshold,precision,recall,f1,tp,fp,fn\n";
+  for (const MethodEvaluation& m : report.methods) {
+    auto add = [&](int obj_id, int instances) {
+      for (const PrPoint& p : precisionRecallCurve(m.outcomes, instances, obj_id))
+        out += fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{},{},{}\n", methodName(m.method), obj_id, p.threshold,
+                           p.scores.precision, p.scores.recall, p.scores.f1, p.scores.tp, p.scores.fp, p.scores.fn);
+    };
+    add(0, m.summary.total.tp + m.summary.total.fn);
+    for (const auto& [obj_id, s] : m.summary.objects) add(obj_id, s.tp + s.fn);
+  }
+  return out;
 }
 
 std::string evalReportJson(const EvalReport& report) {
