@@ -96,6 +96,23 @@ void applyCloseRange(SynthParams& params, const py::object& camera_distance, con
   }
 }
 
+/// What synth() and synth_frame() share: the meshes, the layout and what goes in it, the seed,
+/// and the close-range camera and bin.
+SynthParams synthParamsOf(const py::object& meshes, const std::string& layout, uint32_t seed,
+                          const py::object& instances, int clutter, const std::string& units,
+                          const py::object& camera_distance, const py::object& bin_size) {
+  SynthParams params;
+  applyCloseRange(params, camera_distance, bin_size);
+  params.meshes = pathsOf(meshes, "meshes");
+  if (layout != "table" && layout != "bin") valueError(fmt::format("layout: '{}' is neither 'table' nor 'bin'", layout));
+  params.placement.layout = layout == "bin" ? Layout::Bin : Layout::Table;
+  params.seed = seed;
+  std::tie(params.min_instances, params.max_instances) = countRange(instances, "instances");
+  params.clutter = clutter;
+  params.units = parseMeshUnits(units);
+  return params;
+}
+
 py::dict resultRow(const BopResult& r) {
   py::dict row;
   row["scene_id"] = r.scene_id;
@@ -178,19 +195,10 @@ void bindData(py::module_& m) {
          const std::vector<int>& symmetric, const std::string& units, const py::object& camera,
          const py::object& camera_distance, const py::object& bin_size, bool overwrite, const py::object& device,
          const py::object& progress) {
-        SynthParams params;
-        applyCloseRange(params, camera_distance, bin_size);
-        params.meshes = pathsOf(meshes, "meshes");
+        SynthParams params = synthParamsOf(meshes, layout, seed, instances, clutter, units, camera_distance, bin_size);
         params.images = images;
         params.poses = poses;
-        if (layout != "table" && layout != "bin")
-          valueError(fmt::format("layout: '{}' is neither 'table' nor 'bin'", layout));
-        params.placement.layout = layout == "bin" ? Layout::Bin : Layout::Table;
-        params.seed = seed;
-        std::tie(params.min_instances, params.max_instances) = countRange(instances, "instances");
-        params.clutter = clutter;
         params.symmetric = symmetric;
-        params.units = parseMeshUnits(units);
         if (!camera.is_none()) params.camera = cameraOf(camera, 640, 480, "camera");
         validateSynthParams(params);
         const std::string out_dir = pathOf(out, "out");
@@ -234,17 +242,8 @@ parts and the view).)");
       [](const py::object& meshes, int index, uint32_t seed, const std::string& layout, const py::object& instances,
          int clutter, const std::string& units, const py::object& camera_distance, const py::object& bin_size,
          const py::object& device) {
-        SynthParams params;
-        applyCloseRange(params, camera_distance, bin_size);
-        params.meshes = pathsOf(meshes, "meshes");
+        SynthParams params = synthParamsOf(meshes, layout, seed, instances, clutter, units, camera_distance, bin_size);
         params.images = index + 1;
-        params.seed = seed;
-        if (layout != "table" && layout != "bin")
-          valueError(fmt::format("layout: '{}' is neither 'table' nor 'bin'", layout));
-        params.placement.layout = layout == "bin" ? Layout::Bin : Layout::Table;
-        std::tie(params.min_instances, params.max_instances) = countRange(instances, "instances");
-        params.clutter = clutter;
-        params.units = parseMeshUnits(units);
         if (index < 0) valueError(fmt::format("index: {} is negative", index));
         validateSynthParams(params);
         const std::shared_ptr<Device> dev = deviceOf(device);

@@ -204,14 +204,11 @@ void bindDetect(py::module_& m) {
            })
       .def("__setattr__",
            [](const ConfigSection& s, const std::string& key, const py::object& value) {
-             DetectorParams probe = s.params();
-             std::vector<ConfigField> fields = configFields(probe);
              try {
-               fieldOf(fields, s.section, key);
+               setField(s.params(), s.section, key, value);  // looks the key up before setting anything
              } catch (const py::key_error& e) {
                throw py::attribute_error(e.what());
              }
-             setField(s.params(), s.section, key, value);
            })
       .def("__dir__",
            [](const ConfigSection& s) {
@@ -285,9 +282,8 @@ leaves the config as it was.)")
            "A table of every parameter: section.key, value, meaning and unit")
       .def("__eq__", [](const DetectorParams& a, const DetectorParams& b) { return configJson(a) == configJson(b); })
       .def("__repr__", [](const DetectorParams& p) {
-        const DetectorParams defaults;
         std::string changed;
-        DetectorParams copy = p, base = defaults;
+        DetectorParams copy = p, base;  // configFields points into them; base holds the defaults
         const auto fields = configFields(copy), base_fields = configFields(base);
         for (std::size_t i = 0; i < fields.size(); ++i) {
           const py::object v = valueOf(fields[i]);
