@@ -129,7 +129,7 @@ std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector
 const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups() {
   static const std::vector<std::pair<std::string, std::vector<std::string>>> groups = {
       {"features", {"features"}},
-      {"similarity", {"similarity", "match_readback"}},
+      {"similarity", {"depth_pruning", "similarity", "match_readback"}},
       {"clustering", {"clustering"}},
       {"scoring", {"scoring"}},
       {"nms", {"nms"}},
@@ -199,6 +199,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   std::map<std::string, std::vector<double>> times;
   std::vector<double> totals, match_ms;
   std::vector<std::size_t> detections;  // per timed frame, to compare with frames in flight
+  uint64_t pairs = 0, pruned = 0, skipped = 0;
   for (int i = 0; i < o.warmup; ++i) {
     const DetectionResult r = detector.detect(frames[0].frame, frames[0].camera);
     for (const auto& [stage, ms] : r.timings_ms)
@@ -221,7 +222,10 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
       if (ran) times[group].push_back(ms);
     }
     totals.push_back(by_name["total"] - upload);
-    match_ms.push_back(by_name["features"] + by_name["similarity"] + by_name["match_readback"]);
+    match_ms.push_back(by_name["depth_pruning"] + by_name["features"] + by_name["similarity"] + by_name["match_readback"]);
+    pairs += r.match_pairs;
+    pruned += r.match_pairs_pruned;
+    skipped += r.match_pairs_skipped;
     report.mean_matches += static_cast<double>(r.matches) / o.frames;
     report.mean_hypotheses += static_cast<double>(r.hypotheses) / o.frames;
     report.mean_detections += static_cast<double>(r.detections.size()) / o.frames;
@@ -234,6 +238,10 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
       for (const double t : it->second) sum += t;
       report.stages.push_back({group, median(it->second), percentile(it->second, 95), sum / o.frames});
     }
+  if (pairs > 0) {
+    report.pruned_share = static_cast<double>(pruned) / static_cast<double>(pairs);
+    report.skipped_share = static_cast<double>(skipped) / static_cast<double>(pairs);
+  }
   double total_sum = 0;
   for (const double t : totals) total_sum += t;
   report.stages.push_back({"total", median(totals), percentile(totals, 95), total_sum / o.frames});
@@ -298,6 +306,11 @@ std::string formatDetectReport(const DetectBenchReport& r) {
     out += fmt::format("{:<14} {:>12.1f} {:>12.1f} {:>12.1f}\n", s.stage, s.median_ms, s.p95_ms, s.mean_ms);
   out += fmt::format("\n{:.3f} frames/s; per frame {:.0f} matches, {:.0f} hypotheses, {:.1f} detections\n",
                      r.frames_per_s, r.mean_matches, r.mean_hypotheses, r.mean_detections);
+  out += r.pruned_share > 0 || r.skipped_share > 0
+             ? fmt::format("depth-guided pruning: {:.1f} % of the (template, position) pairs pruned, {:.1f} % skipped "
+                           "unread\n",
+                           100.0 * r.pruned_share, 100.0 * r.skipped_share)
+             : std::string("depth-guided pruning: off\n");
   if (r.frames_per_s_in_flight > 0)
     out += fmt::format("two frames in flight (the next frame's stages 1-2 during this frame's CPU stages): {:.3f} "
                        "frames/s, {:.2f} x frame by frame{}\n",
@@ -330,6 +343,8 @@ nlohmann::json detectReportJson(const DetectBenchReport& r) {
                       {"mean_matches", r.mean_matches},
                       {"mean_hypotheses", r.mean_hypotheses},
                       {"mean_detections", r.mean_detections},
+                      {"pruned_share", r.pruned_share},
+                      {"skipped_share", r.skipped_share},
                       {"memory", {{"peak_rss_bytes", r.peak_rss_bytes},
                                   {"gpu_peak_bytes", r.gpu_peak_bytes},
                                   {"gpu_live_bytes", r.gpu_live_bytes}}},

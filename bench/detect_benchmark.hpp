@@ -57,6 +57,9 @@ struct DetectBenchReport {
   double frames_per_s_in_flight = 0;
   bool in_flight_same_detections = true;
   double mean_matches = 0, mean_hypotheses = 0, mean_detections = 0;
+  /// Depth-guided pruning over the timed frames: shares of the coarse pass's (template,
+  /// position) pairs pruned, and skipped whole by the GPU (both 0 when off).
+  double pruned_share = 0, skipped_share = 0;
   /// cv::linemod on the same frames with the same templates and threshold (0 when not run).
   double opencv_match_ms = 0;   ///< median per frame
   double vkpose_match_ms = 0;   ///< median per frame of features + similarity (with readback)

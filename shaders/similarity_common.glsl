@@ -67,6 +67,7 @@ void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
 
 // Template header: first feature, feature count, first cell column, first cell row, raw
 // threshold, then the coarse level's columns and rows of positions (match::coarseRange),
-// unused.
+// the depth gate (match::TemplateDepthGate: anchor cell column and row offsets, least and
+// greatest depth in mm), unused.
 layout(std430, binding = 1) readonly buffer Templates { int headers[]; };
-const int HEADER_INTS = 8;
+const int HEADER_INTS = 12;

@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include "gpu/batch.hpp"
+#include "match/depth_gate.hpp"
 #include "match/features.hpp"
 #include "match/frame_features_gpu.hpp"
 #include "match/match_geometry.hpp"
@@ -200,6 +201,90 @@ TEST(GpuParity, TemplatesWithMoreThan63FeaturesUse16BitSums) {
   int max_raw = 0;
   for (const auto& m : reference) max_raw = std::max(max_raw, m.raw_score);
   EXPECT_GT(max_raw, 255);
+}
+
+// Depth gates for templates cut from a frame: the anchor at the template's centre, training
+// distances taking turns over `distances` (metres), a 10 cm object, 10 cm apart.
+std::vector<match::TemplateDepthGate> gatesFor(const std::vector<LinemodTemplate>& templates,
+                                               const FeatureParams& params, const std::vector<float>& distances) {
+  std::vector<match::TemplateDepthGate> gates;
+  for (std::size_t i = 0; i < templates.size(); ++i) {
+    BankTemplate t;
+    t.distance = distances[i % distances.size()];
+    t.anchor_x = 0.5f * static_cast<float>(templates[i].levels[0].width);
+    t.anchor_y = 0.5f * static_cast<float>(templates[i].levels[0].height);
+    gates.push_back(match::templateDepthGate(t, 0.1f, 0.1f, params));
+  }
+  match::numberDepthBands(gates);
+  return gates;
+}
+
+// Issue 21's parity test: with depth-guided pruning the GPU gives exactly the matches of the
+// reference whose coarse positions pass the depth test, a subset of the unpruned matches;
+// the counts it reports are the brute-force counts.
+void expectPrunedParity(const LinemodFrame& frame, const std::vector<float>& distances, int template_count,
+                        const std::string& name, bool expect_skips = true) {
+  const FeatureParams params;
+  auto templates = test::templatesFrom(frame, params, template_count);
+  ASSERT_GT(templates.size(), 10u);
+  MatchParams mp;
+  mp.threshold = 75.0f;
+  DepthPruning pruning;
+  pruning.gates = gatesFor(templates, params, distances);
+  const auto layouts = match::makeLayouts(templates, params, frame.bgr.cols, frame.bgr.rows);
+  pruning.cells = match::anchorDepthCells(frame.depth_mm, layouts.back(), static_cast<int>(layouts.size()) - 1);
+  const auto pyramid = quantizeFramePyramid(frame, params);
+  const auto unpruned = matchTemplatesReference(pyramid, templates, params, mp);
+  const auto reference = matchTemplatesReference(pyramid, templates, params, mp, &pruning);
+  EXPECT_GT(reference.size(), 0u) << name;
+  EXPECT_LT(reference.size(), unpruned.size()) << name << ": nothing was pruned";
+
+  LinemodMatcher matcher(test::context(), params, mp);
+  matcher.setTemplates(templates, pruning.gates);
+  const auto ours = matcher.match(frame);
+  ASSERT_EQ(ours.size(), reference.size()) << name;
+  for (std::size_t i = 0; i < ours.size(); ++i) ASSERT_EQ(ours[i], reference[i]) << name << ": match " << i;
+  for (const auto& m : ours) EXPECT_NE(std::find(unpruned.begin(), unpruned.end(), m), unpruned.end()) << name;
+
+  // The counts, against a walk over every template's every position.
+  uint64_t pairs = 0, pruned = 0;
+  for (std::size_t t = 0; t < templates.size(); ++t) {
+    const auto& level = templates[t].levels.back();
+    const auto range = match::coarseRange(
+        level, layouts.back(), match::rawThreshold(static_cast<int>(level.features.size()), mp.threshold));
+    for (int r = range.r_lo; r < range.r_lo + range.rows; ++r)
+      for (int c = range.c_lo; c < range.c_lo + range.columns; ++c) {
+        ++pairs;
+        if (!match::positionPasses(pruning.cells, pruning.gates[t], r, c)) ++pruned;
+      }
+  }
+  const auto& timings = matcher.lastTimings();
+  EXPECT_EQ(timings.pairs, pairs) << name;
+  EXPECT_EQ(timings.pairs_pruned, pruned) << name;
+  EXPECT_GT(timings.pairs_pruned, 0u) << name;
+  if (expect_skips) {
+    EXPECT_GT(timings.pairs_skipped, 0u) << name << ": no strip was skipped unread";
+  }
+  EXPECT_LE(timings.pairs_skipped, timings.pairs_pruned) << name;
+
+  // Switched off, the matcher scores everything again.
+  MatchParams off = mp;
+  off.depth_pruning = false;
+  LinemodMatcher unpruned_matcher(test::context(), params, off);
+  unpruned_matcher.setTemplates(templates, pruning.gates);
+  EXPECT_EQ(unpruned_matcher.match(frame), unpruned) << name;
+  EXPECT_EQ(unpruned_matcher.lastTimings().pairs, 0u) << name;
+}
+
+TEST(GpuParity, DepthPrunedMatchesAreTheUnprunedOnesThatPassTheDepthTest) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  // IC-BIN's frame spans about 0.7 to 1.7 m; LM-O's about 0.6 to 1.3 m.
+  expectPrunedParity(test::icbinFrame(), {0.6f, 0.8f, 1.0f, 1.4f, 2.5f}, 60, "IC-BIN");
+  expectPrunedParity(test::lmoFrame(), {0.5f, 0.8f, 1.1f, 2.0f}, 60, "LM-O");
+  // Half the depth gone: those cells keep every template (and every strip has some).
+  LinemodFrame half = test::icbinFrame();
+  half.depth_mm(cv::Rect(0, 0, half.depth_mm.cols / 2, half.depth_mm.rows)).setTo(0);
+  expectPrunedParity(half, {0.6f, 1.0f, 2.5f}, 60, "IC-BIN, left half without depth", false);
 }
 
 }  // namespace

@@ -159,3 +159,35 @@ TEST(Verify, RealFrameRanksRefinedPoseAboveShiftedOnes) {
 
 }  // namespace
 }  // namespace vkpose
+
+namespace vkpose {
+namespace {
+
+// Objects compete for the scene they explain (VerifyParams::max_shared_support): the cells a
+// posed model explains are where its points meet the scene depth.
+TEST(Verify, SupportCellsAreWhereTheModelMeetsTheSceneDepth) {
+  Camera camera;
+  camera.width = 64;
+  camera.height = 48;
+  camera.fx = camera.fy = 60.0;
+  camera.cx = 32.0;
+  camera.cy = 24.0;
+  cv::Mat depth(48, 64, CV_32FC1, cv::Scalar(1.0f));
+  depth(cv::Rect(0, 0, 16, 48)).setTo(0.f);  // no depth on the left
+  PointCloud on_surface, in_front;
+  for (int v = 0; v < 48; v += 2)
+    for (int u = 0; u < 64; u += 2) {
+      const Eigen::Vector3f ray(static_cast<float>((u - camera.cx) / camera.fx), static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+      on_surface.push_back(ray * 1.005f);
+      in_front.push_back(ray * 0.9f);
+    }
+  const auto cells = supportCells(on_surface, depth, camera, 0.015f);
+  EXPECT_EQ(cells.size(), 12u * 12u) << "the 48 x 48 pixels with depth, in 4 x 4 cells";
+  EXPECT_TRUE(std::is_sorted(cells.begin(), cells.end()));
+  EXPECT_EQ(cells.front(), 4);  // row 0, column 4: the first with depth
+  EXPECT_TRUE(supportCells(in_front, depth, camera, 0.015f).empty()) << "10 cm in front explains nothing";
+  EXPECT_EQ(supportCells(on_surface, depth, camera, 0.015f, 8).size(), 6u * 6u);
+}
+
+}  // namespace
+}  // namespace vkpose

@@ -15,6 +15,10 @@ struct MatchParams {
   /// Similarity in percent a match needs; 0 % is what a random image gives (half the maximum
   /// response per feature), 100 % a perfect match (OpenCV's convention).
   float threshold = 80.0f;
+  /// Where the frame has depth, score a template only at positions whose scene depth suits
+  /// its training distance (docs/pipeline.md, stage 2): the same matches that pass that test,
+  /// for less work.
+  bool depth_pruning = true;
 };
 
 struct ClusterParams {
@@ -134,6 +138,12 @@ struct VerifyParams {
   /// Accept only if at least this share of the outline's samples (where the scene has depth
   /// on both sides, and nothing nearer outside) steps back.
   float min_silhouette_support = 0.55f;
+  /// Objects compete for scene points: best score first, each accepted detection claims the
+  /// scene it explains (4 x 4 pixel cells where a visible model point meets the scene depth
+  /// within see_through_tolerance); one whose explained cells are more than this share
+  /// claimed already by better detections is rejected (a small object laid onto a larger
+  /// one's surface). 1: off.
+  float max_shared_support = 0.5f;
 };
 /// Throws InputError naming the bad value.
 void validateVerifyParams(const VerifyParams& params);

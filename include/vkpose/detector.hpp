@@ -59,6 +59,10 @@ struct DetectionResult {
   std::vector<Detection> rejected;    ///< hypotheses that stages 6-8 rejected, with the reason
   StageTimings timings_ms;
   std::size_t matches = 0, hypotheses = 0, scored_hypotheses = 0;  ///< counts after stages 2, 3, 4
+  /// Stage 2's depth-guided pruning (MatchParams::depth_pruning): (template, position) pairs
+  /// of the coarse pass, those whose scene depth does not suit the template's distance, and
+  /// those of them in strips the GPU skipped whole (no memory read). 0 without pruning.
+  uint64_t match_pairs = 0, match_pairs_pruned = 0, match_pairs_skipped = 0;
   std::vector<std::string> warnings;  ///< e.g. a bank trained for another focal length
 };
 

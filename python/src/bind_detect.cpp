@@ -355,6 +355,12 @@ leaves the config as it was.)")
       .def_property_readonly("matches", [](const PyResult& r) { return r.r.matches; })
       .def_property_readonly("hypotheses", [](const PyResult& r) { return r.r.hypotheses; })
       .def_property_readonly("scored_hypotheses", [](const PyResult& r) { return r.r.scored_hypotheses; })
+      .def_property_readonly("match_pairs", [](const PyResult& r) { return r.r.match_pairs; },
+                             "(template, position) pairs of the coarse pass (0 without depth-guided pruning)")
+      .def_property_readonly("match_pairs_pruned", [](const PyResult& r) { return r.r.match_pairs_pruned; },
+                             "pairs whose scene depth does not suit the template's training distance")
+      .def_property_readonly("match_pairs_skipped", [](const PyResult& r) { return r.r.match_pairs_skipped; },
+                             "pruned pairs the GPU skipped without reading memory")
       .def_property_readonly("warnings", [](const PyResult& r) { return r.r.warnings; })
       .def_property_readonly("camera", [](const PyResult& r) { return r.frame->camera; })
       .def(

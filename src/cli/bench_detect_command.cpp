@@ -41,6 +41,8 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_flag("!--no-pose", options->params.estimate_poses, "Stop after NMS (stages 1-5 only)");
   sub->add_flag("!--no-opencv", options->run_opencv, "Skip the cv::linemod baseline");
+  sub->add_flag("!--no-depth-pruning", options->params.match.depth_pruning,
+                "Score every template at every position (the matcher before depth-guided pruning), to compare");
   sub->add_flag("!--no-in-flight", options->in_flight,
                 "Skip the second run of the frames with two in flight (Detector::detectSequence)");
   sub->add_option("--json", *json_path, "Also write the figures as JSON to this file (never overwritten)");

@@ -345,6 +345,11 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
                result.scored_hypotheses,
                params.estimate_poses ? params.pose_min_score : params.min_score, ctx.device().name);
+    if (global.verbose && result.match_pairs > 0)
+      fmt::print("depth-guided pruning: {:.1f} % of {} (template, position) pairs pruned, {:.1f} % skipped unread\n",
+                 100.0 * static_cast<double>(result.match_pairs_pruned) / static_cast<double>(result.match_pairs),
+                 result.match_pairs,
+                 100.0 * static_cast<double>(result.match_pairs_skipped) / static_cast<double>(result.match_pairs));
     if (!result.rejected.empty())
       fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
                  result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");

@@ -87,7 +87,10 @@ std::string detectionJson(const DetectionResult& result, const DetectionSource& 
                    {"hypotheses", result.hypotheses},
                    {"scored", result.scored_hypotheses},
                    {"rejected", result.rejected.size()},
-                   {"detections", result.detections.size()}};
+                   {"detections", result.detections.size()},
+                   {"match_pairs", result.match_pairs},
+                   {"match_pairs_pruned", result.match_pairs_pruned},
+                   {"match_pairs_skipped", result.match_pairs_skipped}};
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, ms] : result.timings_ms) timings[stage] = round(ms, 3);
   doc["timings_ms"] = std::move(timings);

@@ -28,9 +28,15 @@ LinemodMatcher::LinemodMatcher(GpuContext& context, FeatureParams feature_params
 
 LinemodMatcher::~LinemodMatcher() = default;
 
-void LinemodMatcher::setTemplates(std::vector<LinemodTemplate> templates) {
+void LinemodMatcher::setTemplates(std::vector<LinemodTemplate> templates,
+                                  std::vector<match::TemplateDepthGate> gates) {
   validateTemplates(templates, feature_params_);
+  if (!gates.empty() && gates.size() != templates.size())
+    throw InputError("depth pruning needs one gate per template: " + std::to_string(gates.size()) + " gates for " +
+                     std::to_string(templates.size()) + " templates");
   templates_ = std::move(templates);
+  gates_ = std::move(gates);
+  depth_bands_ = match::numberDepthBands(gates_);
   uploaded_for_ = {};
   chunks_per_pass_ = 0;
 }
@@ -70,11 +76,25 @@ void LinemodMatcher::submitFrame(const LinemodFrame& frame) {
   auto t0 = std::chrono::steady_clock::now();
   if (size != uploaded_for_) {
     layouts_ = match::makeLayouts(templates_, feature_params_, size.width, size.height);
-    similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_);
+    similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_, gates_);
     batch.submit();
     uploaded_for_ = size;
     chunks_per_pass_ = 0;
     timings_.upload_ms = msSince(t0);
+  }
+  // Depth-guided pruning: the frame's anchor cells go up with it; the counts are the host's.
+  t0 = std::chrono::steady_clock::now();
+  const auto cells = params_.depth_pruning && !gates_.empty()
+                         ? match::anchorDepthCells(frame.depth_mm, layouts_.back(), static_cast<int>(layouts_.size()) - 1)
+                         : match::AnchorDepthCells{};
+  const auto boxes = match::bandBoxes(cells, depth_bands_);
+  similarity_->setDepth(batch, cells, boxes);
+  if (!cells.empty()) {
+    const auto count = match::countPruning(cells, gates_, boxes, similarity_->coarseRanges());
+    timings_.pairs = count.pairs;
+    timings_.pairs_pruned = count.pruned;
+    timings_.pairs_skipped = count.skipped;
+    timings_.pruning_ms = msSince(t0);
   }
   // One pass over all template chunks, unless the candidates outgrow what one binding holds
   // (many banks at a low threshold): then passes over fewer chunks each, features computed
@@ -149,7 +169,7 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
       // the frame's passes from the start (its features stay).
       if (!similarity_->splitChunks())
         throw DeviceError("one template's refinement needs more units than a GPU buffer holds; raise the match threshold");
-      similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_);
+      similarity_->setTemplates(batch, templates_, feature_params_, params_, layouts_, gates_);
       batch.submit();
       chunks = similarity_->chunkCount();
       per_pass = chunks;

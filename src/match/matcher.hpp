@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "match/depth_gate.hpp"
 #include "match/features.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"
@@ -26,11 +27,18 @@ struct Match {
 /// Best first: similarity, then template id, then y, then x.
 void sortMatches(std::vector<Match>& matches);
 
+/// Templates' depth gates and a frame's anchor cells (match/depth_gate.hpp).
+struct DepthPruning {
+  std::vector<match::TemplateDepthGate> gates;  ///< one per template
+  match::AnchorDepthCells cells;
+};
+
 /// Stage 2 on the CPU from the quantized pyramid: the reference the GPU matcher is tested
-/// against.
+/// against. With `pruning`, only coarse positions that pass match::positionPasses.
 std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& pyramid,
                                            const std::vector<LinemodTemplate>& templates,
-                                           const FeatureParams& feature_params, const MatchParams& params);
+                                           const FeatureParams& feature_params, const MatchParams& params,
+                                           const DepthPruning* pruning = nullptr);
 
 /// Wall-clock of the last frame's GPU work, host side.
 struct MatchTimings {
@@ -48,6 +56,10 @@ struct MatchTimings {
   /// Template chunks (up to 16,384 templates each; fewer when a chunk's refinement outgrew
   /// a GPU buffer and the chunks were halved).
   std::size_t chunks = 0;
+  /// Depth-guided pruning of the coarse pass (0 when off or the frame has no depth): the
+  /// (template, position) pairs it has, those pruned, and those of strips skipped whole.
+  uint64_t pairs = 0, pairs_pruned = 0, pairs_skipped = 0;
+  double pruning_ms = 0;  ///< host side: the anchor cells and the counts
 };
 
 namespace gpu {
@@ -65,8 +77,9 @@ class LinemodMatcher {
   LinemodMatcher(const LinemodMatcher&) = delete;
   LinemodMatcher& operator=(const LinemodMatcher&) = delete;
 
-  /// Replaces the templates (validated here; uploaded at the next match()).
-  void setTemplates(std::vector<LinemodTemplate> templates);
+  /// Replaces the templates (validated here; uploaded at the next match()). With `gates`
+  /// (one per template) and MatchParams::depth_pruning, frames with depth are pruned.
+  void setTemplates(std::vector<LinemodTemplate> templates, std::vector<match::TemplateDepthGate> gates = {});
   const std::vector<LinemodTemplate>& templates() const { return templates_; }
 
   std::vector<Match> match(const LinemodFrame& frame);
@@ -87,6 +100,8 @@ class LinemodMatcher {
   FeatureParams feature_params_;
   MatchParams params_;
   std::vector<LinemodTemplate> templates_;
+  std::vector<match::TemplateDepthGate> gates_;  ///< empty: no pruning
+  std::vector<std::pair<int, int>> depth_bands_;  ///< the gates' distinct depth intervals
   std::unique_ptr<gpu::FrameFeatures> features_;
   std::unique_ptr<gpu::Similarity> similarity_;
   std::vector<LinearMemoryLayout> layouts_;

@@ -9,10 +9,12 @@
 namespace vkpose::gpu {
 
 namespace {
-constexpr int kHeaderInts = 8;  // HEADER_INTS in shaders/similarity_common.glsl
+constexpr int kHeaderInts = 12;  // HEADER_INTS in shaders/similarity_common.glsl
 constexpr uint32_t kGroup = 64;
 constexpr int kCoarseRows = 2;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
 constexpr int kCoarseSpan = 3;  // blocks of 16 positions per coarse invocation: SPAN there
+static_assert(kCoarseRows == match::kStripRows && 16 * kCoarseSpan == match::kStripColumns,
+              "depth pruning skips what one coarse invocation scores");
 // Coarse workgroup size (local_size_x there): a template needs about 15 invocations at 640 x
 // 480, and on llvmpipe each idle 8-lane vector of a workgroup still costs a pass through
 // the shader, so 64 would spend most of the time on empty lanes.
@@ -42,6 +44,8 @@ struct UnitGrid {
 struct CoarsePush {
   int32_t template_base, stride;
   uint32_t capacity;
+  int32_t depth_cells_x, depth_cells_y;  // 0: no pruning
+  int32_t depth_boxes_at;
 };
 struct UnitsPush {
   uint32_t bands, capacity;  // template bands of the chunk, unit slots
@@ -70,7 +74,8 @@ UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fi
 
 struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
-      : coarse(c, ShaderId::similarity_coarse, 4, sizeof(CoarsePush), {}, kMemoryAndOffsets),
+      : coarse(c, ShaderId::similarity_coarse, 5, sizeof(CoarsePush), {},
+               {{0, vk::Format::eR32G32B32A32Uint}, {2, vk::Format::eR32Sint}, {4, vk::Format::eR32Uint}}),
         mark(c, ShaderId::refine_mark, 4, sizeof(ChunkPush)),
         units(c, ShaderId::refine_units, 7, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
@@ -95,10 +100,12 @@ Similarity::Similarity(const GpuContext& ctx) : ctx_(ctx), kernels_(std::make_un
 Similarity::~Similarity() = default;
 
 void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& templates, const FeatureParams& fp,
-                              const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts) {
+                              const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts,
+                              const std::vector<match::TemplateDepthGate>& gates) {
   feature_params_ = fp;
   layouts_ = layouts;
   chunks_.clear();
+  ranges_.assign(templates.size(), {});
   const std::size_t levels = layouts.size();
   // Chunks: at most 16384 templates (workgroup rows) and features that fit one binding.
   // Each chunk is some 14 dispatches, each a barrier on llvmpipe, so chunks are as large as
@@ -142,8 +149,11 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         const int threshold = match::rawThreshold(n, params.threshold);
         // Only the coarse level scans a range; the finer one scores the units of refinement.
         const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold) : match::CoarseRange{};
+        const match::TemplateDepthGate gate = gates.empty() ? match::TemplateDepthGate{} : gates[t];
         headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
-                                             threshold, range.columns, range.rows, 0});
+                                             threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
+                                             gate.z_lo_mm, gate.z_hi_mm, gate.band});
+        if (l + 1 == levels) ranges_[t] = range;
         if (l + 1 == levels)
           chunk.coarse_invocations = std::max<std::size_t>(
               chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
@@ -176,6 +186,24 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   }
 }
 
+void Similarity::setDepth(Batch& batch, const match::AnchorDepthCells& cells, const std::vector<match::BandBox>& boxes) {
+  depth_cells_x_ = depth_cells_y_ = 0;
+  if (cells.empty()) {
+    depth_.reserve(ctx_, 16);  // bound all the same
+    return;
+  }
+  // The planes, then each band's box (r0, r1, c0, c1) as int bits.
+  std::vector<uint32_t> words(cells.planes);
+  for (const auto& b : boxes)
+    for (const int v : {b.r0, b.r1, b.c0, b.c1}) words.push_back(static_cast<uint32_t>(v));
+  const std::size_t bytes = words.size() * 4;
+  depth_.reserve(ctx_, bytes);
+  batch.upload(depth_, words.data(), bytes);
+  depth_cells_x_ = cells.cells_x;
+  depth_cells_y_ = cells.cells_y;
+  depth_boxes_at_ = static_cast<int>(cells.planes.size());
+}
+
 void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t begin, std::size_t end) {
   const std::size_t coarse = layouts_.size() - 1;
   const auto& cl = layouts_[coarse];
@@ -200,10 +228,10 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
   for (std::size_t c = begin; c < std::min(end, chunks_.size()); ++c) {
     const Chunk& chunk = chunks_[c];
     const std::size_t bands = static_cast<std::size_t>(chunk.template_count) * static_cast<std::size_t>(grid.bands);
-    const CoarsePush push{chunk.first_template, cl.stride, capacity_};
+    const CoarsePush push{chunk.first_template, cl.stride, capacity_, depth_cells_x_, depth_cells_y_, depth_boxes_at_};
     if (chunk.coarse_invocations > 0)
       batch.dispatch(kernels_->coarse,
-                     {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_}, push,
+                     {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_, depth_}, push,
                      groupsFor(chunk.coarse_invocations, kCoarseGroup), static_cast<uint32_t>(chunk.template_count));
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gpu/batch.hpp"
+#include "match/depth_gate.hpp"
 #include "match/match_geometry.hpp"
 
 namespace vkpose::gpu {
@@ -20,8 +21,15 @@ class Similarity {
   ~Similarity();
 
   /// Lays the templates out for `layouts` (one per level) and uploads them through `batch`.
+  /// `gates`: one per template (depth-guided pruning), or empty.
   void setTemplates(Batch& batch, const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
-                    const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts);
+                    const MatchParams& params, const std::vector<LinearMemoryLayout>& layouts,
+                    const std::vector<match::TemplateDepthGate>& gates = {});
+  /// Each template's coarse range (match::coarseRange), as setTemplates() laid it out.
+  const std::vector<match::CoarseRange>& coarseRanges() const { return ranges_; }
+  /// The frame's anchor cells and its depth bands' boxes for depth-guided pruning (empty
+  /// cells: none), uploaded through `batch` for the record()s that follow.
+  void setDepth(Batch& batch, const match::AnchorDepthCells& cells, const std::vector<match::BandBox>& boxes);
 
   /// Template chunks (each one dispatch group); record() covers a range of them.
   std::size_t chunkCount() const { return chunks_.size(); }
@@ -54,6 +62,9 @@ class Similarity {
   std::unique_ptr<Kernels> kernels_;
   std::vector<Chunk> chunks_;
   std::vector<LinearMemoryLayout> layouts_;
+  std::vector<match::CoarseRange> ranges_;
+  int depth_cells_x_ = 0, depth_cells_y_ = 0;  ///< 0: no pruning this frame
+  int depth_boxes_at_ = 0;                      ///< where the band boxes start in depth_, in uints
   FeatureParams feature_params_;
   uint32_t capacity_ = 1u << 16;       // candidate slots
   uint32_t max_capacity_ = 0;          // candidate slots one binding can hold
@@ -65,7 +76,7 @@ class Similarity {
   std::size_t template_bands_ = 0;     // template bands of the largest chunk
   std::size_t block_words_ = 0;        // and its block mark words
   std::size_t column_words_ = 0;       // and its column mark words
-  Buffer candidates_, results_;
+  Buffer candidates_, results_, depth_;
   Buffer columns_, occupied_, blocks_, bases_, shifts_, runs_, scores_, state_;
 };
 

@@ -84,8 +84,11 @@ void scoreRow(const std::vector<uint8_t>& memory, const LinearMemoryLayout& layo
 
 std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& pyramid,
                                            const std::vector<LinemodTemplate>& templates,
-                                           const FeatureParams& fp, const MatchParams& params) {
+                                           const FeatureParams& fp, const MatchParams& params,
+                                           const DepthPruning* pruning) {
   validateFeatureParams(fp);
+  if (pruning && pruning->gates.size() != templates.size())
+    throw InputError("depth pruning needs one gate per template");
   validateTemplates(templates, fp);
   if (!(params.threshold > 0.0f && params.threshold <= 100.0f))
     throw InputError("match threshold " + std::to_string(params.threshold) + " % is outside (0, 100]");
@@ -116,7 +119,8 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
       for (int c0 = range.c_lo; c0 < range.c_lo + range.columns; c0 += match::kRefineWindow) {
         scoreRow(memories[coarse], cl, level, r, c0, scores);
         for (int k = 0; k < match::kRefineWindow && c0 + k < range.c_lo + range.columns; ++k)
-          if (scores[k] > threshold) candidates.push_back({static_cast<int>(ti), r, c0 + k, scores[k]});
+          if (scores[k] > threshold && (!pruning || match::positionPasses(pruning->cells, pruning->gates[ti], r, c0 + k)))
+            candidates.push_back({static_cast<int>(ti), r, c0 + k, scores[k]});
       }
   }
 

@@ -22,6 +22,7 @@ using nlohmann::json;
 std::vector<ConfigField> configFields(DetectorParams& p) {
   return {
       {"match", "threshold", "LINEMOD similarity a match needs, percent", &p.match.threshold},
+      {"match", "depth_pruning", "score templates only where the scene depth suits their distance", &p.match.depth_pruning},
       {"cluster", "position_step_px", "clustering cell s_im, pixels", &p.cluster.position_step_px},
       {"cluster", "min_templates", "smallest cluster tau_c, templates", &p.cluster.min_templates},
       {"score", "depth_unit_m", "alpha = exp(-depth error / unit), metres", &p.score.depth_unit_m},
@@ -77,6 +78,8 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"verify", "silhouette_jump", "a depth step this large marks the outline, metres", &p.verify.silhouette_jump},
       {"verify", "min_silhouette_support", "share of the outline that must show a depth step, 0..1",
        &p.verify.min_silhouette_support},
+      {"verify", "max_shared_support", "share of its scene support a better detection may already claim, 0..1",
+       &p.verify.max_shared_support},
   };
 }
 

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -84,7 +85,7 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   }
   validateDetectorParams(params_);
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
-  matcher_->setTemplates(concatenateTemplates(banks_));
+  matcher_->setTemplates(concatenateTemplates(banks_), match::templateDepthGates(banks_));
   scorer_ = std::make_unique<ClusterScorer>(ctx_);
 }
 
@@ -92,6 +93,7 @@ Detector::~Detector() = default;
 
 void appendMatchTimings(const MatchTimings& t, StageTimings& to) {
   if (t.upload_ms > 0) to.emplace_back("upload", t.upload_ms);
+  if (t.pairs > 0) to.emplace_back("depth_pruning", t.pruning_ms);
   to.emplace_back("features", t.features_ms);
   to.emplace_back("similarity", t.similarity_ms);
   to.emplace_back("match_readback", t.finish_ms);
@@ -158,6 +160,9 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
   appendMatchTimings(matcher_->lastTimings(), result.timings_ms);
   result.matches = matches.size();
+  result.match_pairs = matcher_->lastTimings().pairs;
+  result.match_pairs_pruned = matcher_->lastTimings().pairs_pruned;
+  result.match_pairs_skipped = matcher_->lastTimings().pairs_skipped;
 
   t0 = std::chrono::steady_clock::now();
   std::vector<Hypothesis> hypotheses = clusterTemplates(matches, banks_, params_.cluster);
@@ -288,6 +293,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
   std::vector<VerifyResult> verified(n);
   std::vector<DepthAgreement> agreement(n);
   std::vector<float> support(n, 0.f);
+  std::vector<std::vector<int>> explained(n);  // scene cells each pose explains, for the competition below
   util::parallelFor(
       n,
       [&](std::size_t i) {
@@ -296,10 +302,12 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
         verified[i] = verifyPose(model, initial[i].scene_points, params_.verify);
         agreement[i] = depthAgreement(model, scene.depth_m, camera, params_.verify.see_through_tolerance);
         support[i] = silhouetteSupport(model, scene.depth_m, camera, params_.verify.silhouette_jump);
+        explained[i] = supportCells(model, scene.depth_m, camera, params_.verify.see_through_tolerance);
       },
       params_.threads);
 
   std::vector<Detection> accepted;
+  std::vector<std::vector<int>> accepted_cells;  // explained[i] of accepted[k]
   for (std::size_t i = 0; i < n; ++i) {
     Detection& d = dets[i];
     const TemplateBank& bank = banks_[static_cast<std::size_t>(d.bank)];
@@ -333,11 +341,19 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     }
     d.verified = true;
     accepted.push_back(std::move(d));
+    accepted_cells.push_back(std::move(explained[i]));
   }
   // Two poses in one place: the better one stays (NMS works on image centres; after ICP two
   // clusters of one instance can meet).
-  std::stable_sort(accepted.begin(), accepted.end(), [](const Detection& a, const Detection& b) { return a.score > b.score; });
-  for (auto& d : accepted) {
+  // Then objects compete for the scene: best first, a detection whose explained cells are
+  // mostly claimed by better ones (another object's surface) goes.
+  std::vector<std::size_t> order(accepted.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return accepted[a].score > accepted[b].score; });
+  std::map<int, std::size_t> claimed;  // scene cell -> index into result.detections
+  for (const std::size_t a : order) {
+    Detection& d = accepted[a];
     const TemplateBank& bank = banks_[static_cast<std::size_t>(d.bank)];
     const Eigen::Vector3f c = d.pose.R * bank.centre + d.pose.t;
     const Detection* taken = nullptr;
@@ -353,9 +369,28 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       d.verified = false;
       d.rejection = fmt::format("the same place as a better {} detection", taken->object);
       result.rejected.push_back(std::move(d));
-    } else {
-      result.detections.push_back(std::move(d));
+      continue;
     }
+    // The better detection that claimed most of this one's scene, and how much it claimed.
+    const auto& cells = accepted_cells[a];
+    std::map<std::size_t, std::size_t> shared_with;
+    std::size_t shared = 0;
+    for (const int cell : cells)
+      if (const auto it = claimed.find(cell); it != claimed.end()) ++shared, ++shared_with[it->second];
+    const float share = cells.empty() ? 0.f : static_cast<float>(shared) / static_cast<float>(cells.size());
+    if (share > params_.verify.max_shared_support) {
+      const auto most = std::max_element(shared_with.begin(), shared_with.end(),
+                                         [](const auto& x, const auto& y) { return x.second < y.second; });
+      d.verified = false;
+      d.rejection = fmt::format("{:.0f}% of the scene it explains is explained by better detections (at most {:.0f}%), "
+                                "most by a {} detection",
+                                100 * share, 100 * params_.verify.max_shared_support,
+                                result.detections[most->first].object);
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    for (const int cell : cells) claimed.emplace(cell, result.detections.size());
+    result.detections.push_back(std::move(d));
   }
   result.timings_ms.emplace_back("verification", msSince(t0));
 }

@@ -75,6 +75,8 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the silhouette step must be > 0 metres, got {}", params.silhouette_jump));
   if (!(params.min_silhouette_support >= 0.f && params.min_silhouette_support <= 1.f))
     throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
+  if (!(params.max_shared_support >= 0.f && params.max_shared_support <= 1.f))
+    throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
 }
 
 void validateDetectorParams(const DetectorParams& p) {

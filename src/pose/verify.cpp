@@ -2,8 +2,10 @@
 // visible points against an octree of the scene points.
 #include "pose/verify.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <fmt/core.h>
@@ -87,6 +89,24 @@ DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& sce
   a.occluded = static_cast<float>(occluded) / n;
   a.fits = static_cast<float>(with_depth - seen_through - occluded) / n;
   return a;
+}
+
+std::vector<int> supportCells(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
+                              float tolerance, int cell) {
+  CV_Assert(scene_depth_m.type() == CV_32FC1 && cell > 0);
+  const int cols = (scene_depth_m.cols + cell - 1) / cell, rows = (scene_depth_m.rows + cell - 1) / cell;
+  std::vector<int> cells;
+  for (const auto& p : model_points) {
+    if (!p.allFinite() || !(p.z() > 0.f)) continue;
+    const Eigen::Vector2f uv = camera.project(p);
+    const float z = depthAt(scene_depth_m, uv.x(), uv.y());
+    if (!(z > 0.f) || std::abs(z - p.z()) > tolerance) continue;
+    const int cx = static_cast<int>(std::lround(uv.x())) / cell, cy = static_cast<int>(std::lround(uv.y())) / cell;
+    if (cx >= 0 && cy >= 0 && cx < cols && cy < rows) cells.push_back(cy * cols + cx);
+  }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  return cells;
 }
 
 VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,

@@ -33,6 +33,12 @@ struct DepthAgreement {
 DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
                               float tolerance);
 
+/// The scene a posed model explains: indices (row-major, sorted, unique) of the `cell` x
+/// `cell` pixel cells where a camera-frame model point projects onto scene depth within
+/// `tolerance` of its own. Objects compete for these (VerifyParams::max_shared_support).
+std::vector<int> supportCells(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
+                              float tolerance, int cell = 4);
+
 /// The silhouette test's share (see VerifyParams::silhouette_jump): the outline of the
 /// camera-frame model points projected into the image, sampled every pixel; at each sample the
 /// scene depth 3 px inside and 4 px outside along the outline's normal. Samples where either
