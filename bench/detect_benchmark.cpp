@@ -95,12 +95,12 @@ std::vector<BenchFrame> icbinFrames(const fs::path& icbin, const std::vector<Tem
 /// Random table scenes of the banks' own meshes, 1-2 instances each, with clutter and sensor
 /// noise, seen from the distances the banks were trained for, with their focal lengths.
 std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector<TemplateBank>& banks, int count,
-                                        uint32_t seed, std::string& what) {
+                                        uint32_t seed, int instances, std::string& what) {
   SynthParams p;
   p.seed = seed;
   p.images = count;
-  p.min_instances = 1;
-  p.max_instances = 2;
+  p.min_instances = instances > 0 ? instances : 1;
+  p.max_instances = instances > 0 ? instances : 2;
   const Camera& trained = banks.front().params.camera;
   p.camera = Camera{trained.fx, trained.fy, 319.5, 239.5, 640, 480, 1.0};
   float near = banks.front().params.views.radii.from, far = banks.front().params.views.radii.to;
@@ -120,7 +120,8 @@ std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector
     SynthImage image = synthesizeImage(ctx, p, meshes, i);
     frames.push_back({std::move(image.frame), image.camera});
   }
-  what = fmt::format("synthetic: {} random table scenes of the banks' meshes (seed {})", count, seed);
+  what = fmt::format("synthetic: {} random table scenes of the banks' meshes (seed {}, {} instances of each)", count,
+                     seed, instances > 0 ? std::to_string(instances) : std::string("1-2"));
   return frames;
 }
 
@@ -156,6 +157,8 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   if (o.banks.empty()) throw InputError("bench detect needs at least one --bank");
   if (o.frames < 1) throw InputError(fmt::format("--frames must be 1 or more, not {}", o.frames));
   if (o.warmup < 0) throw InputError(fmt::format("--warmup must be 0 or more, not {}", o.warmup));
+  if (o.instances < 0 || o.instances > 50)
+    throw InputError(fmt::format("instances per object must be 0 (1 to 2) to 50, not {}", o.instances));
   for (const auto& path : o.banks)
     if (!fs::exists(path)) throw InputError("bank '" + path + "' does not exist");
   validateDetectorParams(o.params);
@@ -184,7 +187,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   std::vector<BenchFrame> frames;
   if (source == FrameSource::Lmo) frames = lmoFrames(lmo, report.frames_from);
   else if (source == FrameSource::Icbin) frames = icbinFrames(icbin, banks, report.frames_from);
-  else frames = syntheticFrames(ctx, banks, std::min(o.frames, 8), o.seed, report.frames_from);
+  else frames = syntheticFrames(ctx, banks, std::min(o.frames, 8), o.seed, o.instances, report.frames_from);
   report.frames = o.frames;
   report.warmup = o.warmup;
   report.distinct_frames = static_cast<int>(frames.size());
@@ -355,6 +358,100 @@ nlohmann::json detectReportJson(const DetectBenchReport& r) {
                    {"ratio", r.opencv_ratio},
                    {"matches", r.opencv_matches}};
   return j;
+}
+
+std::vector<DetectSweepRow> runDetectSweep(const DetectBenchOptions& options, DetectSweep sweep,
+                                           const std::vector<int>& counts, const GpuOptions& gpu,
+                                           const BenchProgress& progress) {
+  if (counts.empty()) throw InputError("a sweep needs at least one count");
+  for (const int n : counts)
+    if (n < 1 || n > (sweep == DetectSweep::Objects ? 100 : 50))
+      throw InputError(fmt::format("sweep count {} is outside 1..{}", n, sweep == DetectSweep::Objects ? 100 : 50));
+  if (options.banks.empty()) throw InputError("bench detect needs at least one --bank");
+  std::vector<DetectSweepRow> rows;
+  for (const int n : counts) {
+    DetectBenchOptions o = options;
+    o.run_opencv = false;
+    o.in_flight = false;
+    if (sweep == DetectSweep::Objects) {
+      o.banks.clear();
+      for (int i = 0; i < n; ++i) o.banks.push_back(options.banks[static_cast<std::size_t>(i) % options.banks.size()]);
+    } else {
+      o.source = FrameSource::Synthetic;
+      o.instances = n;
+    }
+    const std::string label = sweep == DetectSweep::Objects ? fmt::format("{} objects", n) : fmt::format("{} instances", n);
+    const DetectBenchReport r = runDetectBenchmark(o, gpu, [&](const std::string& phase, std::size_t done, std::size_t total) {
+      if (progress) progress(label + ": " + phase, done, total);
+    });
+    DetectSweepRow row;
+    row.objects = static_cast<int>(o.banks.size());
+    row.instances = o.instances;
+    row.templates = r.templates;
+    for (const auto& st : r.stages) {
+      if (st.stage == "total") row.total_ms = st.median_ms;
+      else if (st.stage == "initial_pose" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification")
+        row.pose_ms += st.median_ms;
+      else row.match_ms += st.median_ms;
+    }
+    row.matches = r.mean_matches;
+    row.detections = r.mean_detections;
+    row.pruned_share = r.pruned_share;
+    row.device = r.device;
+    row.frames_from = r.frames_from;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string formatDetectSweep(const std::vector<DetectSweepRow>& rows, DetectSweep sweep) {
+  std::string out;
+  if (!rows.empty()) out += fmt::format("device: {}\nframes: {}\n\n", rows.front().device, rows.front().frames_from);
+  out += fmt::format("{:>9} {:>10} {:>11} {:>14} {:>14} {:>9} {:>11} {:>8}\n",
+                     sweep == DetectSweep::Objects ? "objects" : "instances", "templates", "total ms",
+                     "stages 1-5 ms", "stages 6-8 ms", "matches", "detections", "pruned");
+  for (const auto& r : rows)
+    out += fmt::format("{:>9} {:>10} {:>11.1f} {:>14.1f} {:>14.1f} {:>9.0f} {:>11.1f} {:>7.1f}%\n",
+                       sweep == DetectSweep::Objects ? r.objects : r.instances, r.templates, r.total_ms, r.match_ms,
+                       r.pose_ms, r.matches, r.detections, 100.0 * r.pruned_share);
+  out += "(medians per frame; stages 1-5: features to NMS, 6-8: poses and verification)\n";
+  return out;
+}
+
+nlohmann::json detectSweepJson(const std::vector<DetectSweepRow>& rows, DetectSweep sweep) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& r : rows)
+    points.push_back({{"objects", r.objects},
+                      {"instances", r.instances},
+                      {"templates", r.templates},
+                      {"total_ms", r.total_ms},
+                      {"stages_1_5_ms", r.match_ms},
+                      {"stages_6_8_ms", r.pose_ms},
+                      {"matches", r.matches},
+                      {"detections", r.detections},
+                      {"pruned_share", r.pruned_share}});
+  return {{"sweep", sweep == DetectSweep::Objects ? "objects" : "instances"},
+          {"device", rows.empty() ? "" : rows.front().device},
+          {"frames_from", rows.empty() ? "" : rows.front().frames_from},
+          {"points", points}};
+}
+
+std::string detectSweepSvg(const std::vector<DetectSweepRow>& rows, DetectSweep sweep) {
+  PlotSeries total{"whole frame", "#1f77b4", {}}, match{"stages 1-5 (matching to NMS)", "#2ca02c", {}},
+      pose{"stages 6-8 (poses, verification)", "#d62728", {}};
+  for (const auto& r : rows) {
+    const double x = sweep == DetectSweep::Objects ? r.objects : r.instances;
+    total.points.emplace_back(x, r.total_ms);
+    match.points.emplace_back(x, r.match_ms);
+    pose.points.emplace_back(x, r.pose_ms);
+  }
+  PlotSpec spec;
+  spec.title = fmt::format("vkpose detect, {}", rows.empty() ? "" : rows.front().device);
+  spec.x_label = sweep == DetectSweep::Objects ? "objects (banks searched per frame)" : "instances of each object per frame";
+  spec.y_label = "median ms per frame";
+  spec.log_y = true;
+  spec.series = {total, match, pose};
+  return svgLinePlot(spec);
 }
 
 }  // namespace vkpose::bench

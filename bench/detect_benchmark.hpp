@@ -28,6 +28,7 @@ struct DetectBenchOptions {
   FrameSource source = FrameSource::Auto;
   std::string data_dir;            ///< empty: ../shared/data as built in
   uint32_t seed = 1;               ///< synthetic frames
+  int instances = 0;               ///< synthetic frames: instances of each mesh (0: 1 to 2)
   bool run_opencv = true;
   /// Also run the frames through Detector::detectSequence (two frames in flight) and report
   /// its frames/s next to the frame-by-frame figure.
@@ -82,6 +83,31 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& options, const Gp
 /// The stage table, the throughput, the baseline ratio and the memory, as printed.
 std::string formatDetectReport(const DetectBenchReport& report);
 nlohmann::json detectReportJson(const DetectBenchReport& report);
+
+// ---- sweeps: how the frame time grows --------------------------------------------------
+
+enum class DetectSweep { Objects, Instances };
+
+/// One point of a sweep: medians over its frames.
+struct DetectSweepRow {
+  int objects = 0, instances = 0;  ///< instances: per object and synthetic frame (0: 1 to 2)
+  std::size_t templates = 0;
+  double total_ms = 0, match_ms = 0, pose_ms = 0;  ///< whole frame; stages 1-5; stages 6-8
+  double matches = 0, detections = 0, pruned_share = 0;
+  std::string device, frames_from;
+};
+
+/// Objects: the banks, cycled to each count (copies are objects of their own, as many banks
+/// of one size would be), on the frames `options.source` picks. Instances: that many of each
+/// bank's mesh per synthetic frame. Each point is a runDetectBenchmark of its own (no
+/// cv::linemod, no frames in flight).
+std::vector<DetectSweepRow> runDetectSweep(const DetectBenchOptions& options, DetectSweep sweep,
+                                           const std::vector<int>& counts, const GpuOptions& gpu,
+                                           const BenchProgress& progress = {});
+std::string formatDetectSweep(const std::vector<DetectSweepRow>& rows, DetectSweep sweep);
+nlohmann::json detectSweepJson(const std::vector<DetectSweepRow>& rows, DetectSweep sweep);
+/// Median ms per frame against the count: the whole frame, stages 1-5 and stages 6-8.
+std::string detectSweepSvg(const std::vector<DetectSweepRow>& rows, DetectSweep sweep);
 
 /// "auto", "lmo", "icbin", "synthetic"; InputError for anything else.
 FrameSource parseFrameSource(const std::string& name);

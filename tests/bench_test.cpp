@@ -145,3 +145,38 @@ TEST(BenchDetect, BadInputIsAnInputError) {
 
 }  // namespace
 }  // namespace vkpose
+
+namespace vkpose {
+namespace {
+
+TEST(BenchDetect, SweepsOverObjectsAndInstancesGiveAPointEachAndAPlot) {
+  bench::DetectBenchOptions o;
+  o.banks = {smallBoxBank()};
+  o.frames = 1;
+  o.warmup = 0;
+  o.source = bench::FrameSource::Synthetic;
+  const auto objects = bench::runDetectSweep(o, bench::DetectSweep::Objects, {1, 2}, {});
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0].objects, 1);
+  EXPECT_EQ(objects[1].objects, 2);
+  EXPECT_EQ(objects[1].templates, 2 * objects[0].templates) << "the bank, twice";
+  for (const auto& r : objects) {
+    EXPECT_GT(r.total_ms, 0.0);
+    EXPECT_GE(r.total_ms, 0.99 * (r.match_ms + r.pose_ms));
+  }
+  const auto instances = bench::runDetectSweep(o, bench::DetectSweep::Instances, {3}, {});
+  ASSERT_EQ(instances.size(), 1u);
+  EXPECT_EQ(instances[0].instances, 3);
+  EXPECT_NE(instances[0].frames_from.find("3 instances"), std::string::npos) << instances[0].frames_from;
+  const std::string table = bench::formatDetectSweep(objects, bench::DetectSweep::Objects);
+  EXPECT_NE(table.find("objects"), std::string::npos);
+  const std::string svg = bench::detectSweepSvg(objects, bench::DetectSweep::Objects);
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("whole frame"), std::string::npos);
+  EXPECT_EQ(bench::detectSweepJson(instances, bench::DetectSweep::Instances).at("points").size(), 1u);
+  EXPECT_NE(test::inputErrorOf([&] { bench::runDetectSweep(o, bench::DetectSweep::Objects, {0}, {}); }).find("outside"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace vkpose

@@ -45,21 +45,51 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
                 "Score every template at every position (the matcher before depth-guided pruning), to compare");
   sub->add_flag("!--no-in-flight", options->in_flight,
                 "Skip the second run of the frames with two in flight (Detector::detectSequence)");
+  sub->add_option("--instances", options->instances,
+                  "Synthetic frames: instances of each bank's mesh per frame (0: 1 to 2)")
+      ->check(CLI::Range(0, 50))
+      ->capture_default_str();
+  auto sweep = std::make_shared<std::string>();
+  auto counts = std::make_shared<std::vector<int>>();
+  sub->add_option("--sweep", *sweep,
+                  "How the frame time grows: objects (the banks cycled to 1, 3, 8, 20 objects) or instances (1, 2, "
+                  "4, 8 of each object per synthetic frame); --counts overrides the counts; needs --json, the plot "
+                  "goes next to it as .svg")
+      ->check(CLI::IsMember({"objects", "instances"}));
+  sub->add_option("--counts", *counts, "Counts of the sweep (comma separated)")->delimiter(',')->check(CLI::Range(1, 100));
   sub->add_option("--json", *json_path, "Also write the figures as JSON to this file (never overwritten)");
-  return [options, json_path, source, &global]() {
+  return [options, json_path, source, sweep, counts, &global]() {
     options->source = bench::parseFrameSource(*source);
     if (!json_path->empty() && std::filesystem::exists(*json_path))
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");
     std::unique_ptr<ProgressBar> bar;
     std::string phase;
-    const auto report = bench::runDetectBenchmark(
-        *options, global.gpu(), [&](const std::string& now, std::size_t done, std::size_t total) {
-          if (now != phase) {
-            bar = std::make_unique<ProgressBar>(now, global.quiet);
-            phase = now;
-          }
-          bar->update(done, total);
-        });
+    auto show = [&](const std::string& now, std::size_t done, std::size_t total) {
+      if (now != phase) {
+        bar = std::make_unique<ProgressBar>(now, global.quiet);
+        phase = now;
+      }
+      bar->update(done, total);
+    };
+    if (!sweep->empty()) {
+      if (json_path->empty()) throw InputError("--sweep writes its JSON and an SVG plot next to it: give --json FILE");
+      const std::string svg_path = std::filesystem::path(*json_path).replace_extension(".svg").string();
+      if (std::filesystem::exists(svg_path))
+        throw InputError("'" + svg_path + "' exists; vkpose does not overwrite results (remove it first)");
+      const auto kind = *sweep == "objects" ? bench::DetectSweep::Objects : bench::DetectSweep::Instances;
+      const std::vector<int> n = !counts->empty() ? *counts
+                                 : kind == bench::DetectSweep::Objects ? std::vector<int>{1, 3, 8, 20}
+                                                                        : std::vector<int>{1, 2, 4, 8};
+      const auto rows = bench::runDetectSweep(*options, kind, n, global.gpu(), show);
+      bar.reset();
+      fmt::print("{}", bench::formatDetectSweep(rows, kind));
+      writeTextFile(*json_path, bench::detectSweepJson(rows, kind).dump(2) + "\n", false);
+      writeTextFile(svg_path, bench::detectSweepSvg(rows, kind), false);
+      if (!global.quiet) fmt::print("wrote {} and {}\n", *json_path, svg_path);
+      return kOk;
+    }
+    if (!counts->empty()) throw InputError("--counts goes with --sweep");
+    const auto report = bench::runDetectBenchmark(*options, global.gpu(), show);
     bar.reset();
     for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
     fmt::print("{}", bench::formatDetectReport(report));
