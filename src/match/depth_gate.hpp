@@ -3,7 +3,8 @@
 // distance d can only show an object whose surface is about d away, so where the frame has
 // depth it is scored only at positions whose anchor cell (the coarse cell its object centre
 // falls in; outside the frame, the nearest edge cell) holds a depth within the template's
-// gate. Cells without depth keep every template.
+// gate. A cell's depth spans it and its eight neighbours (refinement moves a coarse match by
+// up to half a cell); a neighbourhood without depth keeps every template.
 //
 // Templates of one object and distance share a gate, a depth band. Per frame, each band gets
 // the bounding box of the anchor cells that meet it; the GPU kernel clips each template's
@@ -52,8 +53,9 @@ TemplateDepthGate templateDepthGate(const BankTemplate& t, float diameter_m, flo
 std::vector<TemplateDepthGate> templateDepthGates(const std::vector<TemplateBank>& banks);
 
 /// Depth intervals of a frame's coarse cells. An interval packs the least depth in its low
-/// and the greatest in its high 16 bits (mm); a cell without depth is (0, 0xFFFF), which
-/// meets every gate. Plane 0 holds each cell; plane 1 + k the union of rows r and r + 1 over
+/// and the greatest in its high 16 bits (mm); one whose 3 x 3 neighbourhood has a cell without
+/// depth is (0, 0xFFFF), which meets every gate. Plane 0 holds each cell's interval over its
+/// neighbourhood; plane 1 + k the union of rows r and r + 1 over
 /// columns c .. c + 2^k - 1 (clipped to the grid): a strip's interval is the union of two
 /// entries of one plane, as a sparse table gives it.
 struct AnchorDepthCells {
