@@ -91,12 +91,18 @@ std::string smallBoxBank() {
   return path;
 }
 
-TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
+// The small box bank on one synthetic frame, no warm-up.
+bench::DetectBenchOptions oneSyntheticFrame() {
   bench::DetectBenchOptions o;
   o.banks = {smallBoxBank()};
   o.frames = 1;
   o.warmup = 0;
   o.source = bench::FrameSource::Synthetic;
+  return o;
+}
+
+TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
+  const bench::DetectBenchOptions o = oneSyntheticFrame();
   std::vector<std::string> phases;
   const bench::DetectBenchReport r =
       bench::runDetectBenchmark(o, {}, [&](const std::string& phase, std::size_t, std::size_t) {
@@ -150,11 +156,7 @@ namespace vkpose {
 namespace {
 
 TEST(BenchDetect, SweepsOverObjectsAndInstancesGiveAPointEachAndAPlot) {
-  bench::DetectBenchOptions o;
-  o.banks = {smallBoxBank()};
-  o.frames = 1;
-  o.warmup = 0;
-  o.source = bench::FrameSource::Synthetic;
+  const bench::DetectBenchOptions o = oneSyntheticFrame();
   const auto objects = bench::runDetectSweep(o, bench::DetectSweep::Objects, {1, 2}, {});
   ASSERT_EQ(objects.size(), 2u);
   EXPECT_EQ(objects[0].objects, 1);

@@ -106,22 +106,14 @@ AnchorDepthCells anchorDepthCells(const cv::Mat& depth_mm, const LinearMemoryLay
       out.planes[static_cast<std::size_t>(r) * static_cast<std::size_t>(out.cells_x) + static_cast<std::size_t>(c)] = interval;
     }
   // Plane 1: rows r and r + 1; plane 1 + k: columns c .. c + 2^k - 1 of plane k.
-  auto index = [&](int p, int r, int c) {
-    return (static_cast<std::size_t>(p) * static_cast<std::size_t>(out.cells_y) + static_cast<std::size_t>(r)) *
-               static_cast<std::size_t>(out.cells_x) +
-           static_cast<std::size_t>(c);
-  };
   for (int r = 0; r < out.cells_y; ++r)
     for (int c = 0; c < out.cells_x; ++c)
-      out.planes[index(1, r, c)] =
-          r + 1 < out.cells_y ? unite(out.planes[index(0, r, c)], out.planes[index(0, r + 1, c)]) : out.planes[index(0, r, c)];
+      out.planes[out.index(1, r, c)] = r + 1 < out.cells_y ? unite(out.at(0, r, c), out.at(0, r + 1, c)) : out.at(0, r, c);
   for (int k = 1; k < out.levels; ++k)
     for (int r = 0; r < out.cells_y; ++r)
       for (int c = 0; c < out.cells_x; ++c) {
         const int next = c + (1 << (k - 1));
-        out.planes[index(1 + k, r, c)] = next < out.cells_x
-                                             ? unite(out.planes[index(k, r, c)], out.planes[index(k, r, next)])
-                                             : out.planes[index(k, r, c)];
+        out.planes[out.index(1 + k, r, c)] = next < out.cells_x ? unite(out.at(k, r, c), out.at(k, r, next)) : out.at(k, r, c);
       }
   return out;
 }

@@ -64,11 +64,12 @@ struct AnchorDepthCells {
   int levels = 0;   ///< planes 1 .. levels
   std::vector<uint32_t> planes;
   bool empty() const { return planes.empty(); }
-  uint32_t at(int plane, int r, int c) const {
-    return planes[(static_cast<std::size_t>(plane) * static_cast<std::size_t>(cells_y) + static_cast<std::size_t>(r)) *
-                      static_cast<std::size_t>(cells_x) +
-                  static_cast<std::size_t>(c)];
+  std::size_t index(int plane, int r, int c) const {
+    return (static_cast<std::size_t>(plane) * static_cast<std::size_t>(cells_y) + static_cast<std::size_t>(r)) *
+               static_cast<std::size_t>(cells_x) +
+           static_cast<std::size_t>(c);
   }
+  uint32_t at(int plane, int r, int c) const { return planes[index(plane, r, c)]; }
 };
 
 /// Sparse-table planes needed for windows of up to kStripColumns cells.

@@ -74,8 +74,7 @@ UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fi
 
 struct Similarity::Kernels {
   explicit Kernels(const GpuContext& c)
-      : coarse(c, ShaderId::similarity_coarse, 5, sizeof(CoarsePush), {},
-               {{0, vk::Format::eR32G32B32A32Uint}, {2, vk::Format::eR32Sint}, {4, vk::Format::eR32Uint}}),
+      : coarse(c, ShaderId::similarity_coarse, 5, sizeof(CoarsePush), {}, kCoarseTexels),
         mark(c, ShaderId::refine_mark, 4, sizeof(ChunkPush)),
         units(c, ShaderId::refine_units, 7, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
@@ -91,6 +90,9 @@ struct Similarity::Kernels {
   // Linear memory and feature offsets are read as texel buffers (similarity_common.glsl).
   static inline const std::vector<TexelBinding> kMemoryAndOffsets{{0, vk::Format::eR32G32B32A32Uint},
                                                                   {2, vk::Format::eR32Sint}};
+  // The coarse pass also reads the frame's anchor cells (depth-guided pruning) as r32ui.
+  static inline const std::vector<TexelBinding> kCoarseTexels{kMemoryAndOffsets[0], kMemoryAndOffsets[1],
+                                                              {4, vk::Format::eR32Uint}};
   Kernel coarse, mark, units, args;
   std::vector<std::unique_ptr<Kernel>> refine;  // per run length (specialization constant SPAN)
   Kernel select;
@@ -153,12 +155,13 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
                                              threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
                                              gate.z_lo_mm, gate.z_hi_mm, gate.band});
-        if (l + 1 == levels) ranges_[t] = range;
-        if (l + 1 == levels)
+        if (l + 1 == levels) {
+          ranges_[t] = range;
           chunk.coarse_invocations = std::max<std::size_t>(
               chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
                                             static_cast<std::size_t>((range.columns + 16 * kCoarseSpan - 1) /
                                                                      (16 * kCoarseSpan)));
+        }
         const int T = layout.T;
         for (const auto& f : level.features)
           offsets[l].push_back(static_cast<int32_t>(
