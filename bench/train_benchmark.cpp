@@ -70,6 +70,24 @@ TrainBenchResult runTrainBenchmark(const TrainBenchOptions& options, const GpuOp
   out.features_s = timings.features_ms / 1e3;
   out.templates_per_s = static_cast<double>(out.templates) / out.total_s;
 
+  // The same training with the views quantized one by one by the CPU reference (how training
+  // ran before its quantization moved to the GPU), for the ratio in the same run.
+  if (options.reference) {
+    util::ProgressBar ref_bar("training, CPU quantization", !options.progress);
+    TrainingTimings ref;
+    const auto t_ref = std::chrono::steady_clock::now();
+    const TemplateBank ref_bank =
+        trainTemplatesWith(ctx, mesh, params, sampleViews(params.views, mesh.bboxCentre()),
+                           FeatureQuantization::cpu_reference, [&](std::size_t d, std::size_t n) { ref_bar.update(d, n); },
+                           &ref);
+    out.reference_total_s = secondsSince(t_ref);
+    ref_bar.finish();
+    out.reference_features_s = ref.features_ms / 1e3;
+    out.reference_identical = ref_bank.templates.size() == bank.templates.size();
+    for (std::size_t i = 0; out.reference_identical && i < bank.templates.size(); ++i)
+      out.reference_identical = bank.templates[i].linemod == ref_bank.templates[i].linemod;
+  }
+
   // Same renderings for both: the first views, each rendered (not rotated) on the GPU.
   auto views = sampleViews(params.views, mesh.bboxCentre());
   views.resize(std::min<std::size_t>(views.size(), static_cast<std::size_t>(options.opencv_templates)));

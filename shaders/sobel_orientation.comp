@@ -2,12 +2,14 @@
 // Sobel 3x3 per channel of the smoothed image; the strongest channel gives the pixel's
 // orientation bin (0 on the outermost rows and columns) and whether its squared magnitude
 // passes the weak threshold. In: packed BGRX words. Out: a packed label image (common.glsl)
-// of bin | 8 if strong.
+// of bin | 8 if strong; with write_magnitude, also the squared magnitude per pixel (training
+// ranks its feature candidates by it; frames bind a placeholder and skip the stores).
 #include "common.glsl"
 layout(local_size_x = 64) in;
 layout(binding = 0) uniform utextureBuffer img;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Bins { uint bins[]; };
-layout(push_constant) uniform Push { int width; int height; float threshold_sq; } pc;
+layout(std430, binding = 2) writeonly buffer Magnitudes { int magnitude[]; };
+layout(push_constant) uniform Push { int width; int height; float threshold_sq; int write_magnitude; } pc;
 void main() {
   int i = LINEAR_INVOCATION;
   int y, x0;
@@ -46,4 +48,7 @@ void main() {
     word |= (bin | strong) << (8u * uint(j));
   }
   bins[y * wordsPerRow(pc.width) + x0 / 4] = word & insideBytes(x0, pc.width);
+  if (pc.write_magnitude != 0)
+    [[unroll]] for (int j = 0; j < 4; ++j)
+      if (x0 + j < pc.width) magnitude[y * pc.width + x0 + j] = best_mag[j];
 }

@@ -15,6 +15,7 @@
 #include "render/render.hpp"
 #include "test_support.hpp"
 #include "training/training.hpp"
+#include "training/view_features.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/geometry.hpp"
@@ -109,6 +110,102 @@ TEST(Training, FeaturesFollowLinemodSelection) {
     sum += best;
   }
   EXPECT_GT(sum / pts.size(), 4.0);
+}
+
+// Every level's labels and magnitudes equal, bit for bit.
+void expectSameQuantization(const QuantizedView& a, const QuantizedView& b, const std::string& what) {
+  ASSERT_EQ(a.colour.size(), b.colour.size()) << what;
+  auto same = [&](const cv::Mat& x, const cv::Mat& y, const std::string& name) {
+    ASSERT_EQ(x.size(), y.size()) << what << " " << name;
+    ASSERT_EQ(x.type(), y.type()) << what << " " << name;
+    cv::Mat diff;
+    cv::compare(x, y, diff, cv::CMP_NE);
+    EXPECT_EQ(cv::countNonZero(diff), 0) << what << " " << name << " differs";
+  };
+  for (std::size_t l = 0; l < a.colour.size(); ++l) {
+    const std::string level = fmt::format("level {}", l);
+    same(a.colour[l], b.colour[l], level + " colour labels");
+    same(a.magnitude[l], b.magnitude[l], level + " magnitudes");
+    same(a.depth[l], b.depth[l], level + " depth labels");
+  }
+}
+
+TEST(Training, GpuQuantizationOfPackedCropsEqualsTheReferenceOneByOne) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  // Crops of several sizes (three distances, two objects, in-plane turns), packed into small
+  // atlases so that they fill several shelves and several atlases.
+  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  const Mesh l = test::lShapeMesh();
+  const Camera cam = squareCamera(260);
+  FeatureParams params;
+  std::vector<Rendering> crops;
+  for (const Mesh* mesh : {&cup, &l}) {
+    MeshRenderer renderer(test::context(), *mesh);
+    for (float distance : {0.5f, 0.7f, 0.9f}) {
+      const TrainingView v = lookAtView({0.4f, -0.7f, 0.6f}, mesh->bboxCentre(), distance, 0.f);
+      const Rendering r = renderer.render(cam, {{v.R, v.t}})[0];
+      for (float turn : {0.f, 35.f}) {
+        const Rendering turned = rotateInPlane(r, turn, cam.cx, cam.cy);
+        const cv::Rect roi = featureCrop(cv::boundingRect(turned.mask()), {cam.width, cam.height}, params.T.size());
+        crops.push_back({turned.depth(roi).clone(), turned.normals(roi).clone(), turned.bgr(roi).clone()});
+      }
+    }
+  }
+  std::vector<LinemodFrame> frames;
+  for (const auto& c : crops) frames.push_back({c.bgr, depthMillimetres(c.depth)});
+  ViewQuantizer quantizer(test::context(), params, 2048 * 400);
+  const auto gpu = quantizer.quantize(frames);
+  ASSERT_EQ(gpu.size(), crops.size());
+  for (std::size_t i = 0; i < crops.size(); ++i)
+    expectSameQuantization(gpu[i], quantizeView(crops[i], params), fmt::format("crop {}", i));
+  // The quantizer keeps its buffers: a second, smaller call gives the same again.
+  const auto again = quantizer.quantize({frames[3]});
+  expectSameQuantization(again[0], gpu[3], "crop 3 quantized again");
+}
+
+TEST(Training, TheFeatureCropGivesTheWholeTilesTemplate) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  // featureCrop's margin is small: the crop must still give what the whole tile gives.
+  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  MeshRenderer renderer(test::context(), cup);
+  const Camera cam = squareCamera(240);
+  TrainingParams params;
+  for (float turn : {0.f, 20.f, -50.f}) {
+    const TrainingView v = lookAtView({-0.3f, -0.6f, 0.7f}, cup.bboxCentre(), 0.6f, 0.f);
+    const Rendering r = rotateInPlane(renderer.render(cam, {{v.R, v.t}})[0], turn, cam.cx, cam.cy);
+    const ExtractedTemplate cropped = extractTemplate(r, params);
+    const cv::Rect whole(0, 0, cam.width, cam.height);
+    const ExtractedTemplate full =
+        selectFeatures(quantizeView(r, params.features), r.mask(), whole, cv::boundingRect(r.mask()), params);
+    ASSERT_TRUE(cropped.ok);
+    EXPECT_TRUE(cropped.linemod == full.linemod) << "turned " << turn;
+    EXPECT_EQ(cropped.origin_x, full.origin_x);
+    EXPECT_EQ(cropped.origin_y, full.origin_y);
+  }
+}
+
+TEST(Training, TemplatesAreTheSameWhereverTheViewsAreQuantized) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  TrainingParams params;
+  params.views.viewpoints = 6;
+  params.views.radii = {0.6f, 0.8f, 0.2f};
+  params.views.inplane_deg = {-30.f, 30.f, 30.f};
+  const auto views = sampleViews(params.views, cup.bboxCentre());
+  const TemplateBank gpu = trainTemplatesWith(test::context(), cup, params, views, FeatureQuantization::gpu);
+  const TemplateBank cpu = trainTemplatesWith(test::context(), cup, params, views, FeatureQuantization::cpu_reference);
+  ASSERT_EQ(gpu.templates.size(), views.size());
+  ASSERT_EQ(gpu.templates.size(), cpu.templates.size());
+  for (std::size_t i = 0; i < gpu.templates.size(); ++i) {
+    const BankTemplate &a = gpu.templates[i], &b = cpu.templates[i];
+    EXPECT_TRUE(a.linemod == b.linemod) << "template " << i;
+    EXPECT_EQ(a.anchor_x, b.anchor_x);
+    EXPECT_EQ(a.anchor_y, b.anchor_y);
+    EXPECT_EQ(a.crop.x0, b.crop.x0);
+    EXPECT_EQ(a.crop.y0, b.crop.y0);
+    EXPECT_EQ(a.crop.depth_01mm, b.crop.depth_01mm);
+    EXPECT_EQ(a.crop.normals, b.crop.normals);
+  }
 }
 
 TemplateBank smallLBank() {

@@ -118,16 +118,19 @@ struct TemplateFeature {
   int x = 0, y = 0;  ///< pixels at the template's level, relative to its top-left corner
   uint8_t bin = 0;   ///< orientation bin 0..7
   Modality modality = Modality::ColourGradient;
+  bool operator==(const TemplateFeature&) const = default;
 };
 
 struct TemplateLevel {
   int width = 0, height = 0;  ///< pixels at this level
   std::vector<TemplateFeature> features;
+  bool operator==(const TemplateLevel&) const = default;
 };
 
 /// One view of one object; levels finest first, as many as FeatureParams::T.
 struct LinemodTemplate {
   std::vector<TemplateLevel> levels;
+  bool operator==(const LinemodTemplate&) const = default;
 };
 
 /// Cells (pixels / T) a template spans at a level, as LINEMOD counts them: (size - 1) / T + 1.

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_support.hpp"
 #include "bench/train_benchmark.hpp"
 #include "cli/commands.hpp"
 #include "vkpose/error.hpp"
@@ -23,6 +24,8 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
   sub->add_option("--opencv-templates", options->opencv_templates, "Renderings OpenCV's training is timed on")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  sub->add_flag("!--no-reference", options->reference,
+                "Skip the second training with the CPU reference quantization (the baseline of the ratio)");
   sub->add_option("--json", *json_path, "Write the result as JSON to this file (never overwritten)");
   return [options, json_path, &global]() {
     if (!json_path->empty() && std::filesystem::exists(*json_path))
@@ -33,12 +36,18 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
     fmt::print("device: {}\n", r.device);
     fmt::print("templates: {} in {:.1f} s ({:.0f} templates/s; render {:.1f} s, features {:.1f} s)\n", r.templates,
                r.total_s, r.templates_per_s, r.render_s, r.features_s);
+    if (options->reference)
+      fmt::print("same training, views quantized by the CPU reference: {:.1f} s (features {:.1f} s); GPU quantization "
+                 "is {:.2f}x faster over the whole training{}\n",
+                 r.reference_total_s, r.reference_features_s, r.reference_total_s / r.total_s,
+                 r.reference_identical ? ", identical templates" : "; TEMPLATES DIFFER (a parity bug)");
     fmt::print("per template on the same {} renderings: vkpose features {:.2f} ms, cv::linemod addTemplate {:.2f} ms "
                "({} refused for < 63 features)\n",
                r.opencv_templates, r.vkpose_features_ms, r.opencv_ms, r.opencv_refused);
     fmt::print("ratio (cv::linemod ms per template / vkpose ms per template, whole training): {:.2f}\n", r.ratio);
+    bench::printKernelProfile();
     if (!json_path->empty()) {
-      const nlohmann::json j = {{"mesh", r.mesh},
+      nlohmann::json j = {{"mesh", r.mesh},
                                 {"device", r.device},
                                 {"templates", r.templates},
                                 {"total_s", r.total_s},
@@ -49,6 +58,11 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
                                 {"opencv_ms_per_template", r.opencv_ms},
                                 {"opencv_refused", r.opencv_refused},
                                 {"ratio", r.ratio}};
+      if (options->reference) {
+        j["reference_total_s"] = r.reference_total_s;
+        j["reference_features_s"] = r.reference_features_s;
+        j["reference_identical"] = r.reference_identical;
+      }
       std::ofstream(*json_path) << j.dump(2) << "\n";
     }
     return kOk;

@@ -35,7 +35,7 @@ struct FrameFeatures::Kernels {
   explicit Kernels(const GpuContext& c)
       : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush), {}, kWords),
         blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush), {}, {{0, vk::Format::eR32G32Uint}}),
-        sobel(c, ShaderId::sobel_orientation, 2, 12, {}, kWords),
+        sobel(c, ShaderId::sobel_orientation, 3, 16, {}, kWords),
         vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush), {}, kWords),
         pyr_down(c, ShaderId::pyr_down, 2, 16, {}, kWords),
         normals(c, ShaderId::depth_normals, 2, 16, {}, {{0, vk::Format::eR16Uint}}),
@@ -56,7 +56,6 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
   auto& k = *kernels_;
   const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
   const auto sizes = match::levelSizes(full.width, full.height, params_.T.size());
-  levels_.resize(sizes.size());
   // The linear memories of a level are bound whole (a storage buffer here, a texel buffer in
   // the similarity kernels): a frame whose memories exceed what the device binds at once is
   // refused up front with the size that fits, not by a failing dispatch.
@@ -72,67 +71,13 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
           static_cast<double>(bindable) / (1 << 20), static_cast<int>(full.width * scale * 0.98),
           static_cast<int>(full.height * scale * 0.98)));
     }
-  for (std::size_t l = 0; l < sizes.size(); ++l) {
+  recordQuantization(batch, frame, false);
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = levels_[l];
-    L.size = sizes[l];
-    const std::size_t n = static_cast<std::size_t>(L.size.area());
-    const SizePush sp{L.size.width, L.size.height};
-    // Sliding-window kernels take kPixelGroup neighbouring pixels of a row, or of a column,
-    // per invocation (GROUP in shaders/common.glsl).
     const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
-    const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kGroup);
-    const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
-    // Label images are packed 4 pixels per word, rows padded to whole words (wordsPerRow in
-    // shaders/common.glsl); their kernels take a word per invocation, spread a column of
-    // kPixelGroup words.
     const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
     const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
     const uint32_t word_column_groups = groupsFor(words_per_row * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
-
-    if (params_.use_colour) {
-      // Colour pixels are packed BGRX words on the device (shaders/common.glsl): a word load
-      // per pixel instead of a byte load per channel, each being a loop over the lanes on
-      // llvmpipe. The frame is converted straight into the staging memory.
-      L.bgr.reserve(ctx_, n * 4);
-      if (l == 0) {
-        cv::Mat bgrx(L.size, CV_8UC4, batch.uploadInPlace(L.bgr, n * 4));
-        cv::cvtColor(frame.bgr, bgrx, cv::COLOR_BGR2BGRA);
-      } else {
-        const Level& P = levels_[l - 1];
-        const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
-        batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, row_groups);
-      }
-      L.blur_rows.reserve(ctx_, n * 8);
-      L.smoothed.reserve(ctx_, n * 4);
-      L.raw_bins.reserve(ctx_, label_bytes);
-      L.labels[0].reserve(ctx_, label_bytes);
-      batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
-      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, column_groups);
-      struct {
-        int32_t width, height;
-        float threshold_sq;
-      } sobel_push{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold};
-      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins}, sobel_push, word_groups);
-      batch.dispatchLinear(k.vote, {L.raw_bins, L.labels[0]}, sp, word_groups);
-    }
-    if (params_.use_depth) {
-      L.labels[1].reserve(ctx_, label_bytes);
-      if (l == 0) {
-        depth_.reserve(ctx_, n * 2);
-        L.depth_raw.reserve(ctx_, label_bytes);
-        cv::Mat depth = frame.depth_mm.isContinuous() ? frame.depth_mm : frame.depth_mm.clone();
-        batch.upload(depth_, depth.data, n * 2);
-        const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
-                                 params_.difference_threshold_mm};
-        batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, word_groups);
-        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, word_groups);
-      } else {
-        const Level& P = levels_[l - 1];
-        const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
-        batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, word_groups);
-      }
-    }
-
     // Linear memories: padding cells are never written, so zero the buffer only when its
     // layout changes.
     const LinearMemoryLayout& layout = layouts[l];
@@ -160,6 +105,83 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
                            groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * cell_groups,
                                      kGroup));
     }
+  }
+}
+
+void FrameFeatures::recordQuantization(Batch& batch, const LinemodFrame& frame, bool magnitudes) {
+  auto& k = *kernels_;
+  const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
+  const auto sizes = match::levelSizes(full.width, full.height, params_.T.size());
+  levels_.resize(sizes.size());
+  for (std::size_t l = 0; l < sizes.size(); ++l) {
+    Level& L = levels_[l];
+    L.size = sizes[l];
+    const std::size_t n = static_cast<std::size_t>(L.size.area());
+    const SizePush sp{L.size.width, L.size.height};
+    // Sliding-window kernels take kPixelGroup neighbouring pixels of a row, or of a column,
+    // per invocation (GROUP in shaders/common.glsl).
+    const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
+    const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kGroup);
+    const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
+    // Label images are packed 4 pixels per word, rows padded to whole words (wordsPerRow in
+    // shaders/common.glsl); their kernels take a word per invocation.
+    const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
+    const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
+
+    if (params_.use_colour) {
+      // Colour pixels are packed BGRX words on the device (shaders/common.glsl): a word load
+      // per pixel instead of a byte load per channel, each being a loop over the lanes on
+      // llvmpipe. The frame is converted straight into the staging memory.
+      L.bgr.reserve(ctx_, n * 4);
+      if (l == 0) {
+        cv::Mat bgrx(L.size, CV_8UC4, batch.uploadInPlace(L.bgr, n * 4));
+        cv::cvtColor(frame.bgr, bgrx, cv::COLOR_BGR2BGRA);
+      } else {
+        const Level& P = levels_[l - 1];
+        const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
+        batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, row_groups);
+      }
+      L.blur_rows.reserve(ctx_, n * 8);
+      L.smoothed.reserve(ctx_, n * 4);
+      L.raw_bins.reserve(ctx_, label_bytes);
+      L.labels[0].reserve(ctx_, label_bytes);
+      // Frames need no magnitudes: the kernel skips its stores into a placeholder.
+      L.magnitude.reserve(ctx_, magnitudes ? n * 4 : 4);
+      batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
+      batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, column_groups);
+      struct {
+        int32_t width, height;
+        float threshold_sq;
+        int32_t write_magnitude;
+      } sobel_push{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold, magnitudes ? 1 : 0};
+      batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sobel_push, word_groups);
+      batch.dispatchLinear(k.vote, {L.raw_bins, L.labels[0]}, sp, word_groups);
+    }
+    if (params_.use_depth) {
+      L.labels[1].reserve(ctx_, label_bytes);
+      if (l == 0) {
+        depth_.reserve(ctx_, n * 2);
+        L.depth_raw.reserve(ctx_, label_bytes);
+        cv::Mat depth = frame.depth_mm.isContinuous() ? frame.depth_mm : frame.depth_mm.clone();
+        batch.upload(depth_, depth.data, n * 2);
+        const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
+                                 params_.difference_threshold_mm};
+        batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, word_groups);
+        batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, word_groups);
+      } else {
+        const Level& P = levels_[l - 1];
+        const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
+        batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, word_groups);
+      }
+    }
+  }
+}
+
+void FrameFeatures::downloadMagnitudes(Batch& batch, std::vector<cv::Mat>& out) const {
+  out.resize(levels_.size());
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    out[l].create(levels_[l].size, CV_32SC1);  // the caller's image when it has this size
+    batch.download(levels_[l].magnitude, out[l].data, out[l].total() * 4);
   }
 }
 

@@ -18,6 +18,11 @@ class FrameFeatures {
   /// Records uploads and kernels for `frame` into `batch`; linear memories use `layouts`.
   void record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts);
 
+  /// Only the quantized labels of every level (no spreading, no linear memories), and with
+  /// `magnitudes` the colour gradient's squared magnitude per pixel too: what training picks
+  /// its features from (src/training/view_features.cpp).
+  void recordQuantization(Batch& batch, const LinemodFrame& frame, bool magnitudes);
+
   const Buffer& labels(std::size_t level, int modality) const { return levels_[level].labels[modality]; }
   /// Linear memory of a level, a nibble per cell (responses are 0..4): cell c of the layout
   /// is bits 4 (c % 2) .. 4 (c % 2) + 3 of byte c / 2. The similarity kernels' texel fetches,
@@ -27,11 +32,15 @@ class FrameFeatures {
 
   /// Records downloads of the label images into `out` (valid after batch.submit()).
   void downloadLabels(Batch& batch, std::vector<QuantizedLevel>& out) const;
+  /// Records downloads of the squared gradient magnitudes (CV_32SC1 per level; after a
+  /// recordQuantization with `magnitudes`, valid after batch.submit()); images of `out` that
+  /// have the right size already are written in place.
+  void downloadMagnitudes(Batch& batch, std::vector<cv::Mat>& out) const;
 
  private:
   struct Level {
     cv::Size size;
-    Buffer bgr, blur_rows, smoothed, raw_bins, depth_raw;
+    Buffer bgr, blur_rows, smoothed, raw_bins, magnitude, depth_raw;
     Buffer labels[kModalityCount];
     Buffer spread_rows, spread;
     Buffer memory;

@@ -10,6 +10,7 @@
 #include "match/features.hpp"
 #include "render/render.hpp"
 #include "training/training.hpp"
+#include "training/view_features.hpp"
 #include "util/parallel.hpp"
 #include "util/timing.hpp"
 #include "vkpose/bank.hpp"
@@ -31,31 +32,79 @@ struct Candidate {
 /// those already taken; the distance relaxes by one pixel after every pass. Each candidate's
 /// distance to the nearest taken feature is kept up to date, and passes that could take
 /// nothing are skipped, which gives the same choice as the plain loop in O(count * n).
+///
+/// Only the candidates within the current distance of a newly taken one are updated (found
+/// through a grid of 8 x 8 pixel buckets): a candidate farther away keeps a stale squared
+/// distance, but stale and true are then both at least the current distance^2, and that
+/// distance only shrinks, so every comparison (may it be taken, and the largest blocked
+/// distance left) comes out as with the true value.
 std::vector<Candidate> selectScattered(std::vector<Candidate> candidates, int count) {
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   if (static_cast<int>(candidates.size()) <= count) return candidates;
+  constexpr int kBucket = 8;
+  int min_x = INT32_MAX, min_y = INT32_MAX, max_x = INT32_MIN, max_y = INT32_MIN;
+  for (const auto& c : candidates) {
+    min_x = std::min(min_x, c.x);
+    min_y = std::min(min_y, c.y);
+    max_x = std::max(max_x, c.x);
+    max_y = std::max(max_y, c.y);
+  }
+  const int buckets_x = (max_x - min_x) / kBucket + 1, buckets_y = (max_y - min_y) / kBucket + 1;
+  auto bucketOf = [&](const Candidate& c) { return (c.y - min_y) / kBucket * buckets_x + (c.x - min_x) / kBucket; };
+  // Candidate indices by bucket (a counting sort).
+  std::vector<int> first(static_cast<std::size_t>(buckets_x) * buckets_y + 1, 0), members(candidates.size());
+  for (const auto& c : candidates) ++first[bucketOf(c) + 1];
+  for (std::size_t b = 1; b < first.size(); ++b) first[b] += first[b - 1];
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (std::size_t i = 0; i < candidates.size(); ++i) members[fill[bucketOf(candidates[i])]++] = static_cast<int>(i);
+  }
   std::vector<Candidate> chosen;
   constexpr float kFar = 1e30f;
   std::vector<float> nearest_sq(candidates.size(), kFar);  // < 0: taken
   float distance = static_cast<float>(candidates.size() / static_cast<std::size_t>(count) + 1);
   while (static_cast<int>(chosen.size()) < count) {
     const float d2 = distance * distance;
+    const int reach = static_cast<int>(std::ceil(distance));
     float best_left = -1.f;
     for (std::size_t i = 0; i < candidates.size() && static_cast<int>(chosen.size()) < count; ++i) {
+      // Most candidates are blocked (or taken: -1): pass over blocks of 8 that hold none to
+      // take, keeping the largest blocked distance, without a branch per candidate.
+      for (; i + 8 <= candidates.size(); i += 8) {
+        bool any = false;
+        float most = best_left;
+        for (std::size_t k = i; k < i + 8; ++k) {
+          any |= nearest_sq[k] >= d2;
+          most = std::max(most, nearest_sq[k]);
+        }
+        if (any) break;
+        best_left = most;
+      }
+      if (i >= candidates.size()) break;
       if (nearest_sq[i] < 0.f) continue;
       if (nearest_sq[i] < d2) {
         best_left = std::max(best_left, nearest_sq[i]);
         continue;
       }
-      chosen.push_back(candidates[i]);
+      const Candidate& taken = candidates[i];
+      chosen.push_back(taken);
       nearest_sq[i] = -1.f;
-      for (std::size_t j = 0; j < candidates.size(); ++j) {
-        if (nearest_sq[j] < 0.f) continue;
-        const float dx = static_cast<float>(candidates[j].x - candidates[i].x),
-                    dy = static_cast<float>(candidates[j].y - candidates[i].y);
-        nearest_sq[j] = std::min(nearest_sq[j], dx * dx + dy * dy);
-      }
+      const int bx0 = std::max(0, (taken.x - reach - min_x) / kBucket),
+                bx1 = std::min(buckets_x - 1, (taken.x + reach - min_x) / kBucket);
+      const int by0 = std::max(0, (taken.y - reach - min_y) / kBucket),
+                by1 = std::min(buckets_y - 1, (taken.y + reach - min_y) / kBucket);
+      for (int by = by0; by <= by1; ++by)
+        for (int bx = bx0; bx <= bx1; ++bx) {
+          const int b = by * buckets_x + bx;
+          for (int k = first[b]; k < first[b + 1]; ++k) {
+            const int j = members[k];
+            if (nearest_sq[j] < 0.f) continue;
+            const float dx = static_cast<float>(candidates[j].x - taken.x),
+                        dy = static_cast<float>(candidates[j].y - taken.y);
+            nearest_sq[j] = std::min(nearest_sq[j], dx * dx + dy * dy);
+          }
+        }
     }
     distance -= 1.f;  // at distance 1 every untaken candidate qualifies, so this ends
     // Skip the passes that would take nothing: the next one that takes something is the
@@ -122,42 +171,60 @@ std::vector<Candidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mas
 
 }  // namespace
 
-ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& params) {
+cv::Rect featureCrop(const cv::Rect& object, cv::Size tile, std::size_t levels) {
+  // The object's box plus a margin of background; its origin is a multiple of 2^levels so the
+  // pyramid samples the same pixels as on the whole tile. Outside the object the tile is
+  // zero (black, no depth), so the filters' replicated and reflected borders at the crop's
+  // edge see the zeros the tile holds there, and every label and magnitude in the crop is
+  // the tile's: the margin only has to keep the candidates' windows (the dilated mask and
+  // its 5 x 5 maxima, 3 pixels of each level) inside the crop at every level.
+  const int align = 1 << levels, margin = 8 << (levels - 1);
+  const int x0 = std::max(0, (object.x - margin) / align * align), y0 = std::max(0, (object.y - margin) / align * align);
+  const int x1 = std::min(tile.width, object.br().x + margin), y1 = std::min(tile.height, object.br().y + margin);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+cv::Mat depthMillimetres(const cv::Mat& depth_m) {
+  cv::Mat depth_mm;
+  depth_m.convertTo(depth_mm, CV_16U, 1000.0);
+  return depth_mm;
+}
+
+QuantizedView quantizeView(const Rendering& crop, const FeatureParams& fp) {
+  const std::size_t levels = fp.T.size();
+  QuantizedView q;
+  q.colour.resize(levels);
+  q.magnitude.resize(levels);
+  q.depth.resize(levels);
+  cv::Mat bgr = crop.bgr;
+  for (std::size_t l = 0; l < levels; ++l) {
+    if (fp.use_colour) {
+      if (l > 0) bgr = pyrDownColour(bgr);
+      q.colour[l] = quantizeColourGradients(bgr, fp.weak_threshold, &q.magnitude[l]);
+    }
+    if (fp.use_depth)
+      q.depth[l] = l == 0 ? quantizeDepthNormals(depthMillimetres(crop.depth), fp.distance_threshold_mm,
+                                                 fp.difference_threshold_mm)
+                          : downsampleLabels(q.depth[l - 1]);
+  }
+  return q;
+}
+
+ExtractedTemplate selectFeatures(const QuantizedView& q, const cv::Mat& crop_mask, const cv::Rect& roi,
+                                 const cv::Rect& object, const TrainingParams& params) {
   const FeatureParams& fp = params.features;
   const std::size_t levels = fp.T.size();
-  // Work on the object's box plus a margin that covers every filter's reach (blur, Sobel,
-  // vote, normals, median, non-maximum suppression) at every level; its origin is a
-  // multiple of 2^levels so the pyramid samples the same pixels as on the whole tile.
-  const cv::Rect object = cv::boundingRect(full.mask());
-  if (object.empty()) return {};
-  const int align = 1 << levels, margin = 16 << (levels - 1);
-  const int x0 = std::max(0, (object.x - margin) / align * align), y0 = std::max(0, (object.y - margin) / align * align);
-  const int x1 = std::min(full.depth.cols, object.br().x + margin), y1 = std::min(full.depth.rows, object.br().y + margin);
-  const cv::Rect roi(x0, y0, x1 - x0, y1 - y0);
-  const Rendering r{full.depth(roi), full.normals(roi), full.bgr(roi)};
-  cv::Mat depth_mm;
-  r.depth.convertTo(depth_mm, CV_16U, 1000.0);
-  cv::Mat mask = r.mask();
-  cv::Mat bgr = r.bgr;
-  cv::Mat depth_labels;
+  const int x0 = roi.x, y0 = roi.y;
+  cv::Mat mask = crop_mask;
   std::vector<std::vector<Candidate>> chosen[kModalityCount];
   for (auto& c : chosen) c.resize(levels);
   for (std::size_t l = 0; l < levels; ++l) {
-    if (l > 0) {
-      mask = downsampleLabels(mask);  // the pixels the depth labels keep
-      if (fp.use_colour) bgr = pyrDownColour(bgr);
-    }
-    if (fp.use_colour) {
-      cv::Mat magnitude;
-      const cv::Mat labels = quantizeColourGradients(bgr, fp.weak_threshold, &magnitude);
-      chosen[0][l] = selectScattered(colourCandidates(labels, magnitude, mask, params.strong_threshold),
+    if (l > 0) mask = downsampleLabels(mask);  // the pixels the depth labels keep
+    if (fp.use_colour)
+      chosen[0][l] = selectScattered(colourCandidates(q.colour[l], q.magnitude[l], mask, params.strong_threshold),
                                      params.features_per_modality);
-    }
-    if (fp.use_depth) {
-      depth_labels = l == 0 ? quantizeDepthNormals(depth_mm, fp.distance_threshold_mm, fp.difference_threshold_mm)
-                            : downsampleLabels(depth_labels);
-      chosen[1][l] = selectScattered(depthCandidates(depth_labels, mask), params.features_per_modality);
-    }
+    if (fp.use_depth)
+      chosen[1][l] = selectScattered(depthCandidates(q.depth[l], mask), params.features_per_modality);
   }
   ExtractedTemplate out;
   // The template's box over all levels and modalities, in level-0 pixels (even origin, so
@@ -191,6 +258,14 @@ ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& p
   out.origin_y = min_y + y0;
   out.ok = true;
   return out;
+}
+
+ExtractedTemplate extractTemplate(const Rendering& full, const TrainingParams& params) {
+  const cv::Rect object = cv::boundingRect(full.mask());
+  if (object.empty()) return {};
+  const cv::Rect roi = featureCrop(object, full.depth.size(), params.features.T.size());
+  const Rendering crop{full.depth(roi), full.normals(roi), full.bgr(roi)};
+  return selectFeatures(quantizeView(crop, params.features), crop.mask(), roi, object, params);
 }
 
 namespace {
@@ -262,6 +337,12 @@ TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const Train
 TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
                                      const std::vector<TrainingView>& views, const TrainingProgress& progress,
                                      TrainingTimings* timings) {
+  return trainTemplatesWith(ctx, mesh, params, views, FeatureQuantization::gpu, progress, timings);
+}
+
+TemplateBank trainTemplatesWith(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
+                                const std::vector<TrainingView>& views, FeatureQuantization quantization,
+                                const TrainingProgress& progress, TrainingTimings* timings) {
   const auto t_start = std::chrono::steady_clock::now();
   validateTrainingParams(params);
   if (views.empty()) throw InputError("no training views");
@@ -289,7 +370,11 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
     members.back().push_back(i);
   }
   MeshRenderer renderer(ctx, mesh);
+  std::unique_ptr<ViewQuantizer> quantizer;
+  if (quantization == FeatureQuantization::gpu) quantizer = std::make_unique<ViewQuantizer>(ctx, params.features);
   const std::size_t per_batch = std::min<std::size_t>(renderer.viewsPerBatch(tile), 32);
+  // Views whose crops are held at once (each about 20 bytes per crop pixel).
+  constexpr std::size_t kViewsPerChunk = 128;
   TrainingTimings t;
   std::size_t done = 0;
   for (std::size_t first = 0; first < bases.size(); first += per_batch) {
@@ -305,27 +390,63 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
         todo.push_back(v);
         render_of.push_back(b - first);
       }
-    std::vector<BankTemplate> made(todo.size());  // no levels: the view gave no template
-    util::parallelFor(todo.size(), [&](std::size_t i) {
-      const TrainingView& v = views[todo[i]];
-      const Rendering view = rotateInPlane(renders[render_of[i]], v.inplane_deg, tile.cx, tile.cy);
-      const ExtractedTemplate e = extractTemplate(view, params);
-      if (!e.ok) return;
-      BankTemplate& bt = made[i];
-      bt.linemod = e.linemod;
-      bt.pose = {v.R, v.t};
-      bt.distance = v.distance;
-      bt.inplane_deg = v.inplane_deg;
-      bt.viewpoint = v.viewpoint;
-      bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
-      bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
-      bt.crop = cropRendering(view, e.object, e.origin_x, e.origin_y);
-    });
-    for (std::size_t i = 0; i < todo.size(); ++i) {
-      if (!made[i].linemod.levels.empty())
-        bank.templates.push_back(std::move(made[i]));
-      else
-        ++t.dropped;
+    for (std::size_t c = 0; c < todo.size(); c += kViewsPerChunk) {
+      const std::size_t m = std::min(kViewsPerChunk, todo.size() - c);
+      // Each view turned in-plane and cut to its feature crop (featureCrop).
+      struct Cropped {
+        Rendering crop;
+        cv::Rect roi, object;
+      };
+      std::vector<Cropped> cropped(m);
+      util::parallelFor(m, [&](std::size_t i) {
+        const Rendering view = rotateInPlane(renders[render_of[c + i]], views[todo[c + i]].inplane_deg, tile.cx, tile.cy);
+        Cropped& v = cropped[i];
+        v.object = cv::boundingRect(view.mask());
+        if (v.object.empty()) return;
+        v.roi = featureCrop(v.object, view.depth.size(), params.features.T.size());
+        v.crop = {view.depth(v.roi).clone(), view.normals(v.roi).clone(), view.bgr(v.roi).clone()};
+      });
+      // Quantized on the GPU in one go, or one by one by the CPU reference.
+      std::vector<std::size_t> seen;
+      for (std::size_t i = 0; i < m; ++i)
+        if (!cropped[i].object.empty()) seen.push_back(i);
+      std::vector<QuantizedView> quantized(m);
+      if (quantizer) {
+        std::vector<LinemodFrame> frames(seen.size());
+        util::parallelFor(seen.size(), [&](std::size_t k) {
+          frames[k] = {cropped[seen[k]].crop.bgr, depthMillimetres(cropped[seen[k]].crop.depth)};
+        });
+        auto q = quantizer->quantize(frames);
+        for (std::size_t k = 0; k < seen.size(); ++k) quantized[seen[k]] = std::move(q[k]);
+      } else {
+        util::parallelFor(seen.size(), [&](std::size_t k) {
+          quantized[seen[k]] = quantizeView(cropped[seen[k]].crop, params.features);
+        });
+      }
+      std::vector<BankTemplate> made(m);  // no levels: the view gave no template
+      util::parallelFor(m, [&](std::size_t i) {
+        const Cropped& v = cropped[i];
+        if (v.object.empty()) return;
+        const ExtractedTemplate e = selectFeatures(quantized[i], v.crop.mask(), v.roi, v.object, params);
+        if (!e.ok) return;
+        const TrainingView& view = views[todo[c + i]];
+        BankTemplate& bt = made[i];
+        bt.linemod = e.linemod;
+        bt.pose = {view.R, view.t};
+        bt.distance = view.distance;
+        bt.inplane_deg = view.inplane_deg;
+        bt.viewpoint = view.viewpoint;
+        bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
+        bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
+        // The object's box and the template's origin in crop pixels.
+        bt.crop = cropRendering(v.crop, e.object - v.roi.tl(), e.origin_x - v.roi.x, e.origin_y - v.roi.y);
+      });
+      for (std::size_t i = 0; i < m; ++i) {
+        if (!made[i].linemod.levels.empty())
+          bank.templates.push_back(std::move(made[i]));
+        else
+          ++t.dropped;
+      }
     }
     t.features_ms += msSince(t0);
     done += todo.size();
