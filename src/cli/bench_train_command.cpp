@@ -41,7 +41,8 @@ Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global) {
                  "is {:.2f}x faster over the whole training{}\n",
                  r.reference_total_s, r.reference_features_s, r.reference_total_s / r.total_s,
                  r.reference_identical ? ", identical templates" : "; TEMPLATES DIFFER (a parity bug)");
-    fmt::print("per template on the same {} renderings: vkpose features {:.2f} ms, cv::linemod addTemplate {:.2f} ms "
+    fmt::print("per template on the same {} renderings, one core: vkpose features (CPU reference) {:.2f} ms, "
+               "cv::linemod addTemplate {:.2f} ms "
                "({} refused for < 63 features)\n",
                r.opencv_templates, r.vkpose_features_ms, r.opencv_ms, r.opencv_refused);
     fmt::print("ratio (cv::linemod ms per template / vkpose ms per template, whole training): {:.2f}\n", r.ratio);
