@@ -142,6 +142,95 @@ TEST(Config, DefaultsRoundTripAndValuesApply) {
   EXPECT_FLOAT_EQ(merged.match.threshold, 85.f);
 }
 
+TEST(ScaledLengths, ObjectsOfTenCentimetresAndMoreKeepTheDefaults) {
+  const DetectorParams defaults;
+  for (float diameter : {0.1f, 0.137f, 0.26f, 1.5f})
+    for (float z : {0.3f, 0.8f, 1.2f})
+      EXPECT_EQ(configJson(scaledForObject(defaults, diameter, z)), configJson(defaults)) << diameter << " m at " << z;
+}
+
+TEST(ScaledLengths, SmallPartsGetLengthsInProportionButNotBelowTheSensorNoise) {
+  const DetectorParams defaults;
+  // A 40 mm part at 0.36 m: the sensor's 1 mm depth step is its noise there.
+  EXPECT_FLOAT_EQ(depthNoise(defaults.sensor, 0.36f), 0.001f);
+  const DetectorParams p = scaledForObject(defaults, 0.04f, 0.36f);
+  EXPECT_FLOAT_EQ(p.verify.resolution, 0.002f);              // 4 mm * 0.4 = 1.6 mm < 2 x noise
+  EXPECT_FLOAT_EQ(p.refine.voxel_size, 0.002f);
+  EXPECT_FLOAT_EQ(p.refine.mls_radius, 0.005f);              // 4 mm < 5 x noise
+  EXPECT_FLOAT_EQ(p.verify.see_through_tolerance, 0.006f);   // 15 mm * 0.4
+  EXPECT_FLOAT_EQ(p.verify.silhouette_jump, 0.004f);         // 10 mm * 0.4
+  EXPECT_FLOAT_EQ(p.verify.crop_margin, 0.008f);
+  // Fractions and everything else stay as they are.
+  EXPECT_EQ(p.verify.threshold, defaults.verify.threshold);
+  EXPECT_EQ(p.refine.fine_fraction, defaults.refine.fine_fraction);
+  // The same part 2 m away: the noise (6 mm) sets the lengths, up to the defaults.
+  const DetectorParams far = scaledForObject(defaults, 0.04f, 2.f);
+  EXPECT_FLOAT_EQ(far.verify.resolution, defaults.verify.resolution);
+  EXPECT_FLOAT_EQ(far.verify.silhouette_jump, defaults.verify.silhouette_jump);
+  // A noiseless sensor: proportion alone.
+  DetectorParams ideal;
+  ideal.sensor = {0.f, 0.f};
+  EXPECT_FLOAT_EQ(scaledForObject(ideal, 0.02f, 0.5f).verify.resolution, 0.0008f);
+}
+
+TEST(ScaledLengths, LengthsTheUserSetAreKept) {
+  DetectorParams p = parseConfig(R"({"verify": {"resolution": 0.003}, "refine": {"voxel_size": 0}})", "t");
+  const DetectorParams scaled = scaledForObject(p, 0.04f, 0.36f);
+  EXPECT_FLOAT_EQ(scaled.verify.resolution, 0.003f);
+  EXPECT_FLOAT_EQ(scaled.refine.voxel_size, 0.f) << "0 (no voxel filter) is the user's choice";
+  EXPECT_FLOAT_EQ(scaled.verify.silhouette_jump, 0.004f) << "the others still follow the part";
+  EXPECT_NE(scaledLengthsReport(p, 0.04f, 0.36f).find("verify.resolution 3.0 mm (set)"), std::string::npos);
+  p.scale_lengths = false;
+  EXPECT_FLOAT_EQ(scaledForObject(p, 0.04f, 0.36f).verify.silhouette_jump, DetectorParams{}.verify.silhouette_jump);
+  // The switch and the sensor are config parameters, and --explain says which lengths follow.
+  EXPECT_FALSE(parseConfig(R"({"detector": {"scale_lengths": false}})", "t").scale_lengths);
+  EXPECT_FLOAT_EQ(parseConfig(R"({"sensor": {"quantization_m": 0.0005}})", "t").sensor.quantization_m, 0.0005f);
+  EXPECT_THROW(parseConfig(R"({"sensor": {"axial_sigma_at_1m": -1}})", "t"), InputError);
+  const std::string table = configTable();
+  for (const ScaledLength& s : scaledLengths())
+    EXPECT_NE(table.find(s.section + "." + s.key), std::string::npos);
+  EXPECT_NE(table.find("[follows the object and the sensor]"), std::string::npos);
+}
+
+TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
+  EXPECT_EQ(sensorProfileNames().front(), "kinect") << "the default first";
+  const SensorParams kinect = sensorProfile("kinect"), d435 = sensorProfile("realsense-d435");
+  EXPECT_EQ(kinect.axial_sigma_at_1m, DetectorParams{}.sensor.axial_sigma_at_1m) << "the default stays today's";
+  EXPECT_EQ(kinect.quantization_m, DetectorParams{}.sensor.quantization_m);
+  EXPECT_GT(d435.axial_sigma_at_1m, kinect.axial_sigma_at_1m);
+  // synth renders what the detector assumes: the default profile is today's synth noise.
+  const DepthNoiseParams today = synthNoise(), from_kinect = synthNoise(kinect), ideal = synthNoise(sensorProfile("ideal"));
+  EXPECT_EQ(from_kinect.axial_sigma_at_1m, today.axial_sigma_at_1m);
+  EXPECT_EQ(from_kinect.quantization_m, today.quantization_m);
+  EXPECT_EQ(from_kinect.holes, today.holes);
+  EXPECT_EQ(ideal.axial_sigma_at_1m, 0.f);
+  EXPECT_EQ(ideal.holes, 0);
+  EXPECT_EQ(ideal.edge_dropout, 0.f);
+  // A noisier sensor makes a small part's lengths coarser at the same distance.
+  DetectorParams p;
+  p.sensor = d435;
+  EXPECT_FLOAT_EQ(scaledForObject(p, 0.04f, 0.8f).verify.resolution, 2 * 0.0025f * 0.8f * 0.8f);
+  EXPECT_FLOAT_EQ(scaledForObject(DetectorParams{}, 0.04f, 0.8f).verify.resolution, 0.002f);
+  // A JSON file, and clear errors.
+  const fs::path dir = freshDir("sensor");
+  fs::create_directories(dir);
+  const std::string file = (dir / "sensor.json").string(), bad = (dir / "bad.json").string();
+  std::ofstream(file) << R"({"axial_sigma_at_1m": 0.002, "quantization_m": 0.0005})";
+  std::ofstream(bad) << R"({"sigma": 0.002})";
+  EXPECT_FLOAT_EQ(sensorProfile(file).axial_sigma_at_1m, 0.002f);
+  EXPECT_FLOAT_EQ(sensorProfile(file).quantization_m, 0.0005f);
+  auto message = [](const std::string& what) {
+    try {
+      sensorProfile(what);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("kinnect").find("kinect, primesense, realsense-d435, ideal"), std::string::npos);
+  EXPECT_NE(message(bad).find("unknown key \"sigma\""), std::string::npos);
+}
+
 TEST(Config, BadFilesAreClearErrors) {
   auto message = [](const std::string& text) {
     try {

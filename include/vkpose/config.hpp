@@ -148,6 +148,24 @@ struct VerifyParams {
 /// Throws InputError naming the bad value.
 void validateVerifyParams(const VerifyParams& params);
 
+/// The depth sensor's noise, which the scaled lengths (below) follow at the object's distance.
+/// The defaults are the Kinect-like model `vkpose synth` renders with (synth.hpp).
+struct SensorParams {
+  float axial_sigma_at_1m = 0.0015f;  ///< axial noise sigma(z) = this * z^2, metres at 1 m
+  float quantization_m = 0.001f;      ///< the depth images' step, metres
+};
+/// Throws InputError naming the bad value.
+void validateSensorParams(const SensorParams& params);
+
+/// A named sensor profile (`--sensor`): "kinect" (the default, structured light: 1.5 mm at
+/// 1 m, a 1 mm step), "primesense" (Carmine-class short range: 1.0 mm at 1 m), "realsense-d435"
+/// (active stereo: 2.5 mm at 1 m) or "ideal" (no noise, no step); or the path of a JSON file
+/// {"axial_sigma_at_1m": metres, "quantization_m": metres}. InputError for an unknown name or
+/// a bad file.
+SensorParams sensorProfile(const std::string& name_or_file);
+/// The profile names sensorProfile() knows, the default first.
+std::vector<std::string> sensorProfileNames();
+
 struct DetectorParams {
   MatchParams match;
   ClusterParams cluster;
@@ -175,9 +193,45 @@ struct DetectorParams {
   /// instance that NMS kept apart in the image converge to one place after ICP).
   float duplicate_fraction = 0.3f;
   unsigned threads = 0;  ///< CPU threads for the per-hypothesis stages (0: all cores)
+  SensorParams sensor;
+  /// The lengths of stages 7-8 that depend on the object's size and the sensor's noise
+  /// (scaledLengths() lists them) follow each object when left at their defaults: the
+  /// defaults were tuned on 10-30 cm objects at 0.6-1.2 m, and a 4 cm part needs finer ones.
+  /// false: every length as given.
+  bool scale_lengths = true;
 };
 /// Throws InputError naming the first bad value of any stage.
 void validateDetectorParams(const DetectorParams& params);
+
+// ---- lengths that follow the object and the sensor -----------------------------------
+
+/// A length parameter that follows the object: left at its default, it becomes
+/// min(default, max(default * diameter / kScaleReferenceDiameter, noise_multiple * noise(z)))
+/// for an object of that diameter at distance z, where noise(z) is the larger of the sensor's
+/// axial sigma and its quantization step. Objects of 10 cm and more keep the default, so what
+/// works today stays as it is; smaller ones get lengths in proportion to their size, but
+/// never below a multiple of what the sensor can resolve there.
+struct ScaledLength {
+  std::string section, key;
+  float noise_multiple = 1.f;
+  std::string why;
+};
+constexpr float kScaleReferenceDiameter = 0.1f;
+
+/// Every scaled length, in pipeline order.
+const std::vector<ScaledLength>& scaledLengths();
+
+/// max(sigma(z), quantization) of the sensor at distance z (metres).
+float depthNoise(const SensorParams& sensor, float distance_m);
+
+/// `params` with each scaled length that is at its default (DetectorParams{}) set for an
+/// object of `diameter_m` at `distance_m`; the others, and everything with scale_lengths
+/// false, as given.
+DetectorParams scaledForObject(const DetectorParams& params, float diameter_m, float distance_m);
+
+/// One line per scaled length: its value for this object at this distance, and whether it
+/// was derived or set by the user.
+std::string scaledLengthsReport(const DetectorParams& params, float diameter_m, float distance_m);
 
 // ---- the config file ------------------------------------------------------------------
 

@@ -80,6 +80,9 @@ Camera tejaniCamera();
 /// A structured-light sensor's noise as synth adds it: DepthNoiseParams' defaults plus grazing
 /// dropouts from 65 degrees, eight holes a frame and a 4 m range.
 DepthNoiseParams synthNoise();
+/// The same with a sensor profile's axial noise and depth step (config.hpp's sensorProfile());
+/// a noiseless profile ("ideal") also reads every pixel: no dropout at edges or grazing angles, no holes.
+DepthNoiseParams synthNoise(const SensorParams& sensor);
 
 struct SynthParams {
   std::vector<std::string> meshes;          ///< obj_id = 1 + index

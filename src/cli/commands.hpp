@@ -36,6 +36,8 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
 Runner addConfigCommand(CLI::App& app, const GlobalOptions& global);
 /// Adds `--config FILE` (stage parameters, config.hpp) to a command.
 void addConfigOption(CLI::App* sub, std::string& path);
+/// `--sensor NAME|FILE` (config.hpp's sensorProfile()); `what` says what the sensor sets.
+void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what);
 /// The stage parameters of a command: the config file's (when `path` is not empty), overridden
 /// by the flags that differ from the defaults.
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);

@@ -13,6 +13,15 @@ void addConfigOption(CLI::App* sub, std::string& path) {
                   "command line win");
 }
 
+void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what) {
+  std::string names;
+  for (const auto& n : sensorProfileNames()) names += (names.empty() ? "" : "|") + n;
+  sub->add_option("--sensor", sensor,
+                  fmt::format("Depth sensor: {} (default {}), or a JSON file {{\"axial_sigma_at_1m\": m, "
+                              "\"quantization_m\": m}}; {}",
+                              names, sensorProfileNames().front(), what));
+}
+
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags) {
   if (path.empty()) return from_flags;
   return mergeConfig(DetectorParams{}, loadConfig(path), from_flags);

@@ -27,9 +27,20 @@ namespace vkpose::cli {
 using util::ProgressBar;
 
 namespace {
+
+/// The lengths of stages 7-8 each object gets (config.hpp's scaled lengths), at the middle of
+/// its bank's training distances, where its pose candidates mostly lie.
+void printScaledLengths(const std::vector<TemplateBank>& banks, const DetectorParams& params) {
+  for (const auto& b : banks) {
+    const float z = 0.5f * (b.params.views.radii.from + b.params.views.radii.to);
+    fmt::print("lengths for {} ({:.0f} mm across, at {:.2f} m, depth noise {:.1f} mm): {}\n", b.object, 1e3f * b.diameter,
+               z, 1e3f * depthNoise(params.sensor, z), scaledLengthsReport(params, b.diameter, z));
+  }
+}
+
 struct DetectOptions {
   std::vector<std::string> banks;
-  std::string rgb, depth, camera, camera_entry, out, overlay, config;
+  std::string rgb, depth, camera, camera_entry, out, overlay, config, sensor;
   std::string frames, list, out_dir, jsonl;  // sequences
   bool overlays = false;
   OverlayOptions overlay_options;
@@ -176,6 +187,7 @@ ExitCode runSequence(const DetectOptions& opt, const DetectorParams& params, con
 
   GpuContext ctx(global.gpu());
   Detector detector(ctx, loadBanks(opt.banks, global.quiet), params);
+  if (global.verbose && params.estimate_poses) printScaledLengths(detector.banks(), params);
   if (!global.quiet)
     fmt::print("{} frame{}, {} object{} on {}\n", frames.size(), frames.size() == 1 ? "" : "s", opt.banks.size(),
                opt.banks.size() == 1 ? "" : "s", ctx.device().name);
@@ -266,6 +278,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir")->needs(out_dir);
   sub->add_flag("--force", opt->force, "Overwrite output files that exist");
   addConfigOption(sub, opt->config);
+  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
   auto* stages = "Stage parameters";
   sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
       ->check(CLI::Range(1.0, 100.0))
@@ -327,7 +340,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->group(stages);
   return [opt, &global]() {
-    const DetectorParams params = withConfig(opt->config, opt->params);
+    DetectorParams params = withConfig(opt->config, opt->params);
+    if (!opt->sensor.empty()) params.sensor = sensorProfile(opt->sensor);
     if (!opt->frames.empty() || !opt->list.empty()) return runSequence(*opt, params, global);
     for (const std::string* path : {&opt->out, &opt->overlay})
       if (!path->empty()) checkWritable(*path, opt->force);
@@ -350,6 +364,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
                  100.0 * static_cast<double>(result.match_pairs_pruned) / static_cast<double>(result.match_pairs),
                  result.match_pairs,
                  100.0 * static_cast<double>(result.match_pairs_skipped) / static_cast<double>(result.match_pairs));
+    if (global.verbose && params.estimate_poses) printScaledLengths(detector.banks(), params);
     if (!result.rejected.empty())
       fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
                  result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");

@@ -18,7 +18,7 @@ using util::ProgressBar;
 
 namespace {
 struct EvalOptions {
-  std::string dataset, split = "test", out, report, config, pr_curve;
+  std::string dataset, split = "test", out, report, config, pr_curve, sensor;
   std::vector<std::string> banks, methods;
   bool force = false;
   EvalRunParams params;
@@ -70,6 +70,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
   addConfigOption(sub, opt->config);
+  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
   auto* protocol = "Evaluation protocol";
   sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
       ->check(CLI::Range(0.001, 10.0))
@@ -107,6 +108,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
   return [opt, &global]() {
     EvalRunParams params = opt->params;
     params.detector = withConfig(opt->config, params.detector);
+    if (!opt->sensor.empty()) params.detector.sensor = sensorProfile(opt->sensor);
     params.linemod.match = params.detector.match;
     if (!opt->methods.empty()) {
       params.methods.clear();

@@ -16,7 +16,7 @@ using util::ProgressBar;
 
 namespace {
 struct SynthOptions {
-  std::string units = "auto", layout = "table", instances = "1:3", camera, out, camera_distance, bin_size;
+  std::string units = "auto", layout = "table", instances = "1:3", camera, out, camera_distance, bin_size, sensor;
   bool force = false;
   SynthParams params;
 };
@@ -100,6 +100,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--symmetric", p.symmetric,
                   "obj_id of a mesh with a continuous symmetry about its z axis (models_info.json's "
                   "symmetries_continuous, so ADI scores it); repeat for several");
+  addSensorOption(sub, opt->sensor, "the depth noise and step the images are rendered with");
   sub->add_flag("--force", opt->force,
                 "Write into a non-empty --out: removes its models/, test/000001/ and camera.json first");
   return [opt, &global]() {
@@ -108,6 +109,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     params.placement.layout = opt->layout == "bin" ? Layout::Bin : Layout::Table;
     std::tie(params.min_instances, params.max_instances) = parseRange(opt->instances);
     if (!opt->camera.empty()) params.camera = loadCamera(opt->camera);
+    if (!opt->sensor.empty()) params.noise = synthNoise(sensorProfile(opt->sensor));
     if (!opt->camera_distance.empty()) {
       const auto d = parseMetres(opt->camera_distance, "--camera-distance", 2, 2);
       params.camera_range.min_distance_m = d[0];

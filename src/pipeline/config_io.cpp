@@ -80,6 +80,10 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
        &p.verify.min_silhouette_support},
       {"verify", "max_shared_support", "share of its scene support a better detection may already claim, 0..1",
        &p.verify.max_shared_support},
+      {"sensor", "axial_sigma_at_1m", "depth noise sigma(z) = this * z^2, metres at 1 m", &p.sensor.axial_sigma_at_1m},
+      {"sensor", "quantization_m", "the depth images' step, metres", &p.sensor.quantization_m},
+      {"detector", "scale_lengths", "lengths left at their defaults follow each object's size and the sensor's noise",
+       &p.scale_lengths},
   };
 }
 
@@ -152,8 +156,74 @@ std::string configJson(const DetectorParams& params) {
 std::string configTable(const DetectorParams& params) {
   DetectorParams p = params;
   std::string out = fmt::format("{:<42} {:>10}  {}\n", "parameter", "default", "meaning");
+  for (const ConfigField& f : configFields(p)) {
+    const auto& scaled = scaledLengths();
+    const bool follows = std::any_of(scaled.begin(), scaled.end(),
+                                     [&](const ScaledLength& s) { return s.section == f.section && s.key == f.key; });
+    out += fmt::format("{:<42} {:>10}  {}{}\n", f.section + "." + f.key, shown(valueOf(f)), f.doc,
+                       follows ? " [follows the object and the sensor]" : "");
+  }
+  out += fmt::format(
+      "\nLengths that follow the object and the sensor (detector.scale_lengths true, the default): left at its\n"
+      "default, each becomes min(default, max(default * diameter / {:g} m, k * noise(z))) for an object of that\n"
+      "diameter whose pose candidate lies at distance z, noise(z) being the larger of the sensor's axial sigma\n"
+      "(sensor.axial_sigma_at_1m * z^2) and its depth step (sensor.quantization_m). Objects of {:g} cm and more\n"
+      "keep the defaults; smaller ones get lengths in proportion, never below k times what the sensor resolves.\n"
+      "A length set to anything but its default (file or flag) is used as given. `vkpose -v detect` prints the\n"
+      "values used per object.\n\n",
+      kScaleReferenceDiameter, 100 * kScaleReferenceDiameter);
+  out += fmt::format("{:<42} {:>4}  {}\n", "length", "k", "why it follows the object and the sensor");
+  for (const ScaledLength& s : scaledLengths())
+    out += fmt::format("{:<42} {:>4g}  {}\n", s.section + "." + s.key, s.noise_multiple, s.why);
+  return out;
+}
+
+const std::vector<ScaledLength>& scaledLengths() {
+  static const std::vector<ScaledLength> lengths = {
+      {"refine", "mls_radius", 5.f, "the smoothing neighbourhood must hold enough points, yet stay small against the object"},
+      {"refine", "voxel_size", 2.f, "a 10 mm nut is 2-3 voxels of 4 mm; the grid must resolve the object's shape"},
+      {"verify", "resolution", 2.f, "octree leaves: fine enough for the object's shape, coarse enough for the noise"},
+      {"verify", "crop_margin", 5.f, "the scene around the model that the octree holds"},
+      {"verify", "see_through_tolerance", 5.f, "how far behind the model the scene must be to see through it"},
+      {"verify", "silhouette_jump", 3.f, "a small part lying on a table shows a step of its own height, not 1 cm"},
+  };
+  return lengths;
+}
+
+float depthNoise(const SensorParams& sensor, float distance_m) {
+  return std::max(sensor.axial_sigma_at_1m * distance_m * distance_m, sensor.quantization_m);
+}
+
+namespace {
+float* lengthField(DetectorParams& p, const ScaledLength& s) {
   for (const ConfigField& f : configFields(p))
-    out += fmt::format("{:<42} {:>10}  {}\n", f.section + "." + f.key, shown(valueOf(f)), f.doc);
+    if (f.section == s.section && f.key == s.key) return std::get<float*>(f.value);
+  throw std::logic_error("scaled length " + s.section + "." + s.key + " is not a float parameter");
+}
+}  // namespace
+
+DetectorParams scaledForObject(const DetectorParams& params, float diameter_m, float distance_m) {
+  DetectorParams out = params;
+  if (!params.scale_lengths || !(diameter_m > 0.f)) return out;
+  DetectorParams defaults;
+  const float noise = depthNoise(params.sensor, std::max(distance_m, 0.f));
+  for (const ScaledLength& s : scaledLengths()) {
+    float* value = lengthField(out, s);
+    const float d = *lengthField(defaults, s);
+    if (*value != d) continue;  // set by the user
+    *value = std::min(d, std::max(d * diameter_m / kScaleReferenceDiameter, s.noise_multiple * noise));
+  }
+  return out;
+}
+
+std::string scaledLengthsReport(const DetectorParams& params, float diameter_m, float distance_m) {
+  DetectorParams given = params, used = scaledForObject(params, diameter_m, distance_m), defaults;
+  std::string out;
+  for (const ScaledLength& s : scaledLengths()) {
+    const float g = *lengthField(given, s), u = *lengthField(used, s), d = *lengthField(defaults, s);
+    out += fmt::format("{}{}.{} {:.1f} mm{}", out.empty() ? "" : ", ", s.section, s.key, 1e3f * u,
+                       g != d ? " (set)" : (u != d ? "" : " (default)"));
+  }
   return out;
 }
 

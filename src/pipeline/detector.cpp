@@ -262,14 +262,25 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       params_.threads);
   result.timings_ms.emplace_back("initial_pose", msSince(t0));
 
+  // The lengths of stages 7-8 for each candidate's object at its distance (scaledForObject:
+  // the defaults for objects of 10 cm and more).
+  std::vector<RefineParams> refine_params(n);
+  std::vector<VerifyParams> verify_params(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const DetectorParams scaled = scaledForObject(
+        params_, banks_[static_cast<std::size_t>(hypotheses[i].bank)].diameter, rendered[i].t.z());
+    refine_params[i] = scaled.refine;
+    verify_params[i] = scaled.verify;
+  }
+
   // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).
   t0 = std::chrono::steady_clock::now();
   std::vector<PointCloud> smoothed(n);
-  const RefineParams& rp = params_.refine;
   util::parallelFor(
       n,
       [&](std::size_t i) {
         if (!initial[i].ok) return;
+        const RefineParams& rp = refine_params[i];
         smoothed[i] = rp.mls ? smoothMls(initial[i].scene_points, rp.mls_radius, rp.mls_polynomial_order,
                                          rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f)
                              : initial[i].scene_points;
@@ -277,13 +288,14 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       params_.threads);
   result.timings_ms.emplace_back("mls", msSince(t0));
   t0 = std::chrono::steady_clock::now();
-  RefineParams icp_params = rp;
-  icp_params.mls = false;  // done above
   std::vector<RefineResult> refined(n);
   util::parallelFor(
       n,
       [&](std::size_t i) {
-        if (initial[i].ok) refined[i] = refinePose(initial[i].model_points, smoothed[i], initial[i].pose, icp_params);
+        if (!initial[i].ok) return;
+        RefineParams icp_params = refine_params[i];
+        icp_params.mls = false;  // done above
+        refined[i] = refinePose(initial[i].model_points, smoothed[i], initial[i].pose, icp_params);
       },
       params_.threads);
   result.timings_ms.emplace_back("icp", msSince(t0));
@@ -299,10 +311,11 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       [&](std::size_t i) {
         if (!initial[i].ok) return;
         const PointCloud model = transformed(initial[i].model_points, refined[i].pose);
-        verified[i] = verifyPose(model, initial[i].scene_points, params_.verify);
-        agreement[i] = depthAgreement(model, scene.depth_m, camera, params_.verify.see_through_tolerance);
-        support[i] = silhouetteSupport(model, scene.depth_m, camera, params_.verify.silhouette_jump);
-        explained[i] = supportCells(model, scene.depth_m, camera, params_.verify.see_through_tolerance);
+        const VerifyParams& vp = verify_params[i];
+        verified[i] = verifyPose(model, initial[i].scene_points, vp);
+        agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
+        support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
+        explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
       },
       params_.threads);
 
@@ -326,7 +339,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     d.silhouette_support = support[i];
     d.score = d.collision_rate * (1.f - d.see_through) * d.silhouette_support;
     placeInImage(d, initial[i].model_points, bank.centre, camera);
-    const VerifyParams& vp = params_.verify;
+    const VerifyParams& vp = verify_params[i];
     if (!verified[i].accepted)
       d.rejection = fmt::format("collision rate {:.2f} is not above {:.2f}", d.collision_rate, vp.threshold);
     else if (d.see_through > vp.max_see_through)

@@ -1,9 +1,11 @@
 // The checks of every stage's parameters (include/vkpose/config.hpp), in one GPU-, PCL- and
 // OctoMap-free file: the config file reader and its fuzz target link it without the stages.
 #include <cmath>
+#include <fstream>
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "pose/refine.hpp"
 #include "vkpose/config.hpp"
@@ -79,6 +81,65 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
 }
 
+void validateSensorParams(const SensorParams& p) {
+  if (!(p.axial_sigma_at_1m >= 0.f && p.axial_sigma_at_1m < 1.f) || !(p.quantization_m >= 0.f && p.quantization_m < 1.f))
+    throw InputError(fmt::format("the sensor's noise at 1 m ({} m) and depth step ({} m) must be in [0, 1) metres",
+                                 p.axial_sigma_at_1m, p.quantization_m));
+}
+
+namespace {
+struct NamedSensor {
+  const char* name;
+  SensorParams params;
+};
+// Axial noise at 1 m from the sensors' depth models (Khoshelham and Elberink 2012 for the
+// Kinect; the RealSense D435's is z^2 * subpixel / (focal * baseline) at 0.08 px, 640 px,
+// 50 mm); every one writes millimetre depth images.
+constexpr NamedSensor kSensors[] = {
+    {"kinect", {0.0015f, 0.001f}},
+    {"primesense", {0.0010f, 0.001f}},
+    {"realsense-d435", {0.0025f, 0.001f}},
+    {"ideal", {0.f, 0.f}},
+};
+}  // namespace
+
+std::vector<std::string> sensorProfileNames() {
+  std::vector<std::string> names;
+  for (const auto& s : kSensors) names.emplace_back(s.name);
+  return names;
+}
+
+SensorParams sensorProfile(const std::string& name_or_file) {
+  for (const auto& s : kSensors)
+    if (name_or_file == s.name) return s.params;
+  std::ifstream in(name_or_file);
+  if (!in) {
+    std::string names;
+    for (const auto& s : kSensors) names += std::string(names.empty() ? "" : ", ") + s.name;
+    throw InputError(fmt::format("--sensor '{}' is neither a profile ({}) nor a readable JSON file", name_or_file, names));
+  }
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not a JSON sensor file ({})", name_or_file, e.what()));
+  }
+  SensorParams p;
+  if (!j.is_object()) throw InputError(name_or_file + ": a sensor file is a JSON object");
+  for (const auto& item : j.items()) {
+    float* field = item.key() == "axial_sigma_at_1m" ? &p.axial_sigma_at_1m
+                   : item.key() == "quantization_m"  ? &p.quantization_m
+                                                     : nullptr;
+    if (!field)
+      throw InputError(fmt::format("{}: unknown key \"{}\" (axial_sigma_at_1m, quantization_m)", name_or_file, item.key()));
+    if (!item.value().is_number())
+      throw InputError(fmt::format("{}: {} must be a number of metres", name_or_file, item.key()));
+    *field = item.value().get<float>();
+  }
+  validateSensorParams(p);
+  return p;
+}
+
 void validateDetectorParams(const DetectorParams& p) {
   if (!(p.match.threshold > 0.f && p.match.threshold <= 100.f))
     throw InputError(fmt::format("the match threshold must be in (0, 100] percent, not {}", p.match.threshold));
@@ -97,6 +158,7 @@ void validateDetectorParams(const DetectorParams& p) {
   validateVerifyParams(p.verify);
   if (!(p.duplicate_fraction >= 0.f && p.duplicate_fraction <= 10.f))
     throw InputError(fmt::format("the duplicate distance must be in [0, 10] diameters, not {}", p.duplicate_fraction));
+  validateSensorParams(p.sensor);
 }
 
 }  // namespace vkpose

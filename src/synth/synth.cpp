@@ -278,6 +278,18 @@ DepthNoiseParams synthNoise() {
   return n;
 }
 
+DepthNoiseParams synthNoise(const SensorParams& sensor) {
+  DepthNoiseParams n = synthNoise();
+  n.axial_sigma_at_1m = sensor.axial_sigma_at_1m;
+  n.quantization_m = sensor.quantization_m;
+  if (sensor.axial_sigma_at_1m == 0.f && sensor.quantization_m == 0.f) {
+    n.edge_dropout = 0.f;
+    n.grazing_dropout = 0.f;
+    n.holes = 0;
+  }
+  return n;
+}
+
 namespace {
 
 /// Image `index` of a dataset: its scene, the rendering and the sensor frame, all drawn from
