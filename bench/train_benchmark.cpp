@@ -104,9 +104,7 @@ TrainBenchResult runTrainBenchmark(const TrainBenchOptions& options, const GpuOp
   auto detector = makeOpenCvDetector(params.features);
   std::vector<std::pair<cv::Mat, cv::Mat>> sources;
   for (const auto& r : renders) {
-    cv::Mat depth_mm;
-    r.depth.convertTo(depth_mm, CV_16U, 1000.0);
-    sources.emplace_back(r.bgr, depth_mm);
+    sources.emplace_back(r.bgr, depthMillimetres(r.depth));
   }
   t1 = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < renders.size(); ++i) {

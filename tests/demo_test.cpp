@@ -1,5 +1,6 @@
 // The demo and what it is made of: procedural meshes, upright placement, views from above,
 // the bank cache, the config file, and the demo end to end on a small template set.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -171,6 +172,19 @@ TEST(ScaledLengths, SmallPartsGetLengthsInProportionButNotBelowTheSensorNoise) {
   DetectorParams ideal;
   ideal.sensor = {0.f, 0.f};
   EXPECT_FLOAT_EQ(scaledForObject(ideal, 0.02f, 0.5f).verify.resolution, 0.0008f);
+}
+
+TEST(Config, ScaledLengthsAreTheirConfigFields) {
+  // Each scaled length's accessor is the float field its section and key name in the file.
+  DetectorParams p;
+  const auto fields = configFields(p);
+  for (const ScaledLength& s : scaledLengths()) {
+    const auto f = std::find_if(fields.begin(), fields.end(),
+                                [&](const ConfigField& c) { return c.section == s.section && c.key == s.key; });
+    ASSERT_NE(f, fields.end()) << s.section << "." << s.key;
+    ASSERT_TRUE(std::holds_alternative<float*>(f->value)) << s.section << "." << s.key;
+    EXPECT_EQ(std::get<float*>(f->value), &s.field(p)) << s.section << "." << s.key;
+  }
 }
 
 TEST(ScaledLengths, LengthsTheUserSetAreKept) {

@@ -212,7 +212,8 @@ void validateDetectorParams(const DetectorParams& params);
 /// works today stays as it is; smaller ones get lengths in proportion to their size, but
 /// never below a multiple of what the sensor can resolve there.
 struct ScaledLength {
-  std::string section, key;
+  std::string section, key;  ///< as the config file names it
+  float& (*field)(DetectorParams&) = nullptr;
   float noise_multiple = 1.f;
   std::string why;
 };

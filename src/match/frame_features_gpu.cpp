@@ -55,7 +55,6 @@ FrameFeatures::~FrameFeatures() = default;
 void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts) {
   auto& k = *kernels_;
   const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
-  const auto sizes = match::levelSizes(full.width, full.height, params_.T.size());
   // The linear memories of a level are bound whole (a storage buffer here, a texel buffer in
   // the similarity kernels): a frame whose memories exceed what the device binds at once is
   // refused up front with the size that fits, not by a failing dispatch.

@@ -179,13 +179,21 @@ std::string configTable(const DetectorParams& params) {
 }
 
 const std::vector<ScaledLength>& scaledLengths() {
+  // The field accessors keep scaledForObject, which runs per pose candidate, off the
+  // configFields() name lookup; Config.ScaledLengthsAreTheirConfigFields checks the names.
   static const std::vector<ScaledLength> lengths = {
-      {"refine", "mls_radius", 5.f, "the smoothing neighbourhood must hold enough points, yet stay small against the object"},
-      {"refine", "voxel_size", 2.f, "a 10 mm nut is 2-3 voxels of 4 mm; the grid must resolve the object's shape"},
-      {"verify", "resolution", 2.f, "octree leaves: fine enough for the object's shape, coarse enough for the noise"},
-      {"verify", "crop_margin", 5.f, "the scene around the model that the octree holds"},
-      {"verify", "see_through_tolerance", 5.f, "how far behind the model the scene must be to see through it"},
-      {"verify", "silhouette_jump", 3.f, "a small part lying on a table shows a step of its own height, not 1 cm"},
+      {"refine", "mls_radius", [](DetectorParams& p) -> float& { return p.refine.mls_radius; }, 5.f,
+       "the smoothing neighbourhood must hold enough points, yet stay small against the object"},
+      {"refine", "voxel_size", [](DetectorParams& p) -> float& { return p.refine.voxel_size; }, 2.f,
+       "a 10 mm nut is 2-3 voxels of 4 mm; the grid must resolve the object's shape"},
+      {"verify", "resolution", [](DetectorParams& p) -> float& { return p.verify.resolution; }, 2.f,
+       "octree leaves: fine enough for the object's shape, coarse enough for the noise"},
+      {"verify", "crop_margin", [](DetectorParams& p) -> float& { return p.verify.crop_margin; }, 5.f,
+       "the scene around the model that the octree holds"},
+      {"verify", "see_through_tolerance", [](DetectorParams& p) -> float& { return p.verify.see_through_tolerance; }, 5.f,
+       "how far behind the model the scene must be to see through it"},
+      {"verify", "silhouette_jump", [](DetectorParams& p) -> float& { return p.verify.silhouette_jump; }, 3.f,
+       "a small part lying on a table shows a step of its own height, not 1 cm"},
   };
   return lengths;
 }
@@ -194,24 +202,16 @@ float depthNoise(const SensorParams& sensor, float distance_m) {
   return std::max(sensor.axial_sigma_at_1m * distance_m * distance_m, sensor.quantization_m);
 }
 
-namespace {
-float* lengthField(DetectorParams& p, const ScaledLength& s) {
-  for (const ConfigField& f : configFields(p))
-    if (f.section == s.section && f.key == s.key) return std::get<float*>(f.value);
-  throw std::logic_error("scaled length " + s.section + "." + s.key + " is not a float parameter");
-}
-}  // namespace
-
 DetectorParams scaledForObject(const DetectorParams& params, float diameter_m, float distance_m) {
   DetectorParams out = params;
   if (!params.scale_lengths || !(diameter_m > 0.f)) return out;
   DetectorParams defaults;
   const float noise = depthNoise(params.sensor, std::max(distance_m, 0.f));
   for (const ScaledLength& s : scaledLengths()) {
-    float* value = lengthField(out, s);
-    const float d = *lengthField(defaults, s);
-    if (*value != d) continue;  // set by the user
-    *value = std::min(d, std::max(d * diameter_m / kScaleReferenceDiameter, s.noise_multiple * noise));
+    float& value = s.field(out);
+    const float d = s.field(defaults);
+    if (value != d) continue;  // set by the user
+    value = std::min(d, std::max(d * diameter_m / kScaleReferenceDiameter, s.noise_multiple * noise));
   }
   return out;
 }
@@ -220,7 +220,7 @@ std::string scaledLengthsReport(const DetectorParams& params, float diameter_m, 
   DetectorParams given = params, used = scaledForObject(params, diameter_m, distance_m), defaults;
   std::string out;
   for (const ScaledLength& s : scaledLengths()) {
-    const float g = *lengthField(given, s), u = *lengthField(used, s), d = *lengthField(defaults, s);
+    const float g = s.field(given), u = s.field(used), d = s.field(defaults);
     out += fmt::format("{}{}.{} {:.1f} mm{}", out.empty() ? "" : ", ", s.section, s.key, 1e3f * u,
                        g != d ? " (set)" : (u != d ? "" : " (default)"));
   }

@@ -115,7 +115,7 @@ SensorParams sensorProfile(const std::string& name_or_file) {
   std::ifstream in(name_or_file);
   if (!in) {
     std::string names;
-    for (const auto& s : kSensors) names += std::string(names.empty() ? "" : ", ") + s.name;
+    for (const auto& n : sensorProfileNames()) names += (names.empty() ? "" : ", ") + n;
     throw InputError(fmt::format("--sensor '{}' is neither a profile ({}) nor a readable JSON file", name_or_file, names));
   }
   nlohmann::json j;
