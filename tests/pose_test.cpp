@@ -149,6 +149,38 @@ TEST(InitialTranslation, MovesTheRenderedModelOntoTheScenePoints) {
   EXPECT_LT(p.scene_points.size(), std::size_t(c.camera.width * c.camera.height / 10));
 }
 
+// Stage 6 renders each candidate in its window only: the window holds every rendered pixel,
+// and the windowed rendering gives the full frame's initial pose, model points and crop.
+TEST(InitialTranslation, TheProjectedWindowGivesTheFullFramesResult) {
+  const TranslationCase c = translationCase({0.008f, -0.006f, 0.02f});
+  float radius = 0.f;
+  for (const auto& v : c.box.vertices) radius = std::max(radius, (v - c.box.bboxCentre()).norm());
+  const cv::Rect window = projectedWindow(c.rendered, c.box.bboxCentre(), radius, c.camera);
+  const cv::Rect drawn = cv::boundingRect(c.rendering.depth > 0.f);
+  EXPECT_EQ(window & drawn, drawn);
+  EXPECT_LT(window.area(), c.camera.width * c.camera.height / 10);
+  const Rendering in_window = renderReference(c.box, windowCamera(c.camera, window), c.rendered);
+  ASSERT_EQ(in_window.depth.size(), window.size());
+  const InitialPose whole = initialTranslation(c.rendering, c.rendered, c.scene_depth, c.camera, c.box.diameter);
+  const InitialPose part =
+      initialTranslation(in_window, c.rendered, c.scene_depth, c.camera, c.box.diameter, {}, window);
+  ASSERT_TRUE(whole.ok && part.ok);
+  // The window's principal point differs by whole pixels: the same coverage, depths to rounding.
+  EXPECT_EQ(part.mask_pixels, whole.mask_pixels);
+  EXPECT_EQ(part.object_pixels, whole.object_pixels);
+  EXPECT_EQ(part.scene_points.size(), whole.scene_points.size());
+  EXPECT_LT((part.pose.t - whole.pose.t).norm(), 1e-5f);
+  // Off the image, or behind the camera: no window.
+  Pose away = c.rendered;
+  away.t.x() += 5.f;
+  EXPECT_TRUE(projectedWindow(away, c.box.bboxCentre(), radius, c.camera).empty());
+  away = c.rendered;
+  away.t.z() = -0.5f;
+  EXPECT_TRUE(projectedWindow(away, c.box.bboxCentre(), radius, c.camera).empty());
+  // A window that is not the rendering's size is a caller's mistake.
+  EXPECT_THROW(initialTranslation(c.rendering, c.rendered, c.scene_depth, c.camera, 0.1f, {}, window), InputError);
+}
+
 TEST(InitialTranslation, AnOccluderDoesNotPullTheModelForward) {
   TranslationCase c = translationCase({0.f, 0.f, 0.015f});
   // Something 10 cm in front covers the left half of the box.

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <random>
 #include <set>
 #include <thread>
 
@@ -13,6 +14,7 @@
 
 #include "cloud_support.hpp"
 #include "mesh_support.hpp"
+#include "pose/nearest_neighbours.hpp"
 #include "pose/point_cloud.hpp"
 #include "pose/refine.hpp"
 #include "test_support.hpp"
@@ -333,6 +335,69 @@ TEST(Refine, ParallelCallsGiveTheSequentialResults) {
     EXPECT_EQ(parallel[i].scene_points, sequential[i].scene_points);
     EXPECT_LT(translationError(sequential[i].pose, s.truth), 0.003f);
   }
+}
+
+// ICP's nearest-neighbour grid against PCL's k-d tree and a brute-force scan: the same point for
+// every query, near the surface (the fine grid answers), centimetres off it (the coarse grid),
+// far away (the whole-cloud scan), with non-finite points in the cloud and a grid squeezed
+// into a few cells.
+TEST(NearestNeighbours, FindTheSamePointsAsPclsKdTreeAndABruteForceScan) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uni(-1.f, 1.f);
+  std::normal_distribution<float> noise(0.f, 0.002f);
+  // A voxel-filtered surface crop, like ICP's scene: a bumpy patch 12 cm across, a ledge, a
+  // few stray points, one NaN and one infinite point.
+  PointCloud surface;
+  for (int i = 0; i < 6000; ++i) {
+    const float x = 0.06f * uni(rng), y = 0.06f * uni(rng);
+    const float z = 0.7f + 0.01f * std::sin(40.f * x) * std::cos(30.f * y) + (x > 0.03f ? 0.02f : 0.f) + noise(rng);
+    surface.emplace_back(x, y, z);
+  }
+  for (int i = 0; i < 20; ++i) surface.emplace_back(0.1f * uni(rng), 0.1f * uni(rng), 0.7f + 0.1f * uni(rng));
+  surface.insert(surface.begin() + 17, Eigen::Vector3f(std::nanf(""), 0.f, 0.7f));
+  surface.push_back(Eigen::Vector3f(0.f, std::numeric_limits<float>::infinity(), 0.7f));
+  const PointCloud cloud = voxelFilter(surface, 0.004f);
+  PointCloud queries;
+  for (const float spread : {0.002f, 0.01f, 0.03f, 0.3f})  // near, centimetres off, far
+    for (int i = 0; i < 500; ++i) {
+      const Eigen::Vector3f p = cloud[std::uniform_int_distribution<std::size_t>(0, cloud.size() - 1)(rng)];
+      queries.push_back(p + spread * Eigen::Vector3f(uni(rng), uni(rng), uni(rng)));
+    }
+  queries.push_back(Eigen::Vector3f(std::nanf(""), 0.f, 0.f));
+  PointCloud with_bad = cloud;  // the grid must skip what the filter would have dropped
+  with_bad.insert(with_bad.begin() + 3, Eigen::Vector3f(std::nanf(""), 0.f, 0.7f));
+
+  const std::vector<int> pcl_nearest = nearestByPclKdTree(with_bad, queries);
+  for (const std::size_t max_cells : {std::size_t(1) << 22, std::size_t(64)}) {
+    const NearestNeighbours grid(with_bad, 0.004f, max_cells);
+    EXPECT_EQ(grid.size(), cloud.size());
+    std::size_t differ_from_pcl = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      float d = 0.f;
+      const int found = grid.nearest(queries[q], d);
+      if (!queries[q].allFinite()) {
+        EXPECT_EQ(found, -1);
+        continue;
+      }
+      float brute = std::numeric_limits<float>::infinity();
+      for (const auto& p : with_bad)
+        if (p.allFinite()) brute = std::min(brute, (p - queries[q]).squaredNorm());
+      ASSERT_GE(found, 0);
+      EXPECT_EQ(d, brute) << "query " << q;
+      EXPECT_EQ(d, (with_bad[static_cast<std::size_t>(found)] - queries[q]).squaredNorm());
+      if (found != pcl_nearest[q]) {  // a tie, nothing else
+        ++differ_from_pcl;
+        EXPECT_EQ((with_bad[static_cast<std::size_t>(pcl_nearest[q])] - queries[q]).squaredNorm(), d);
+      }
+    }
+    EXPECT_LE(differ_from_pcl, 2u);
+    // The far queries need the whole-cloud scan, the near ones never.
+    EXPECT_GT(grid.fullScans(), 0u);
+    EXPECT_LT(grid.fullScans(), 1000u);
+  }
+  float d = 0.f;
+  EXPECT_EQ(NearestNeighbours({}, 0.004f).nearest(Eigen::Vector3f(0.f, 0.f, 1.f), d), -1);
+  EXPECT_NE(test::inputErrorOf([] { NearestNeighbours({Eigen::Vector3f::Zero()}, 0.f); }).find("cell size"), std::string::npos);
 }
 
 }  // namespace

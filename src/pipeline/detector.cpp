@@ -241,23 +241,34 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     const auto workspace = makeRenderWorkspace(ctx_);
     for (const auto& b : banks_) renderers_.push_back(std::make_unique<MeshRenderer>(ctx_, b.mesh, workspace));
   }
+  // Each candidate renders in its own window (projectedWindow: the box of the object's
+  // bounding sphere), one small submit each: a full-frame rendering per candidate cost more
+  // than the rest of stage 6.
+  std::vector<float> bounding_radius(banks_.size(), 0.f);
+  for (std::size_t b = 0; b < banks_.size(); ++b)
+    for (const auto& v : banks_[b].mesh.vertices)
+      bounding_radius[b] = std::max(bounding_radius[b], (v - banks_[b].centre).norm());
   std::vector<Rendering> renderings(n);
-  for (std::size_t b = 0; b < banks_.size(); ++b) {
-    std::vector<std::size_t> which;
-    std::vector<Pose> poses;
-    for (std::size_t i = 0; i < n; ++i)
-      if (static_cast<std::size_t>(hypotheses[i].bank) == b) which.push_back(i), poses.push_back(rendered[i]);
-    if (poses.empty()) continue;
-    std::vector<Rendering> r = renderers_[b]->render(camera, poses);
-    for (std::size_t k = 0; k < which.size(); ++k) renderings[which[k]] = std::move(r[k]);
+  std::vector<cv::Rect> windows(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto b = static_cast<std::size_t>(hypotheses[i].bank);
+    windows[i] = projectedWindow(rendered[i], banks_[b].centre, bounding_radius[b], camera);
+    if (windows[i].empty()) continue;  // initialTranslation says why
+    renderings[i] = std::move(renderers_[b]->render(windowCamera(camera, windows[i]), {rendered[i]}).front());
   }
   std::vector<InitialPose> initial(n);
   util::parallelFor(
       n,
       [&](std::size_t i) {
+        if (windows[i].empty()) {
+          initial[i].pose = rendered[i];
+          initial[i].why = "the model renders outside the image";
+          return;
+        }
         const float diameter = banks_[static_cast<std::size_t>(hypotheses[i].bank)].diameter;
-        initial[i] = initialTranslation(renderings[i], rendered[i], scene.depth_m, camera, diameter, params_.initial_pose);
-        renderings[i] = {};  // a full-frame rendering per hypothesis adds up
+        initial[i] = initialTranslation(renderings[i], rendered[i], scene.depth_m, camera, diameter,
+                                        params_.initial_pose, windows[i]);
+        renderings[i] = {};
       },
       params_.threads);
   result.timings_ms.emplace_back("initial_pose", msSince(t0));

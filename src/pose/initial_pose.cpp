@@ -111,12 +111,45 @@ Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const 
   return p;
 }
 
+cv::Rect projectedWindow(const Pose& pose, const Eigen::Vector3f& centre, float radius, const Camera& camera,
+                         int margin_px) {
+  const Eigen::Vector3f c = pose.R * centre + pose.t;
+  const cv::Rect image(0, 0, camera.width, camera.height);
+  if (!(c.z() > radius) || !c.allFinite()) return {};  // reaches behind the camera
+  // The sphere's image is an ellipse inside the circle of radius f r / (z - r) around the
+  // projected centre (the projection of its nearest cross-section bounds it).
+  const Eigen::Vector2f uv = camera.project(c);
+  const float scale = radius / (c.z() - radius);
+  const float rx = static_cast<float>(camera.fx) * scale * (1.f + std::abs(c.x()) / c.z()) + static_cast<float>(margin_px);
+  const float ry = static_cast<float>(camera.fy) * scale * (1.f + std::abs(c.y()) / c.z()) + static_cast<float>(margin_px);
+  const float x0 = std::max(uv.x() - rx, -1.f), y0 = std::max(uv.y() - ry, -1.f);
+  const float x1 = std::min(uv.x() + rx, static_cast<float>(camera.width) + 1.f),
+              y1 = std::min(uv.y() + ry, static_cast<float>(camera.height) + 1.f);
+  if (!(x0 < x1 && y0 < y1)) return {};
+  const cv::Rect box(static_cast<int>(std::floor(x0)), static_cast<int>(std::floor(y0)),
+                     static_cast<int>(std::ceil(x1) - std::floor(x0)) + 1, static_cast<int>(std::ceil(y1) - std::floor(y0)) + 1);
+  return box & image;
+}
+
+Camera windowCamera(const Camera& camera, const cv::Rect& window) {
+  Camera w = camera;
+  w.cx = camera.cx - window.x;
+  w.cy = camera.cy - window.y;
+  w.width = window.width;
+  w.height = window.height;
+  return w;
+}
+
 InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered, const cv::Mat& scene_depth_m,
-                               const Camera& camera, float diameter, const InitialPoseParams& params) {
-  if (rendering.depth.size() != scene_depth_m.size() || rendering.depth.type() != CV_32FC1 ||
-      scene_depth_m.type() != CV_32FC1)
-    throw InputError(fmt::format("initial translation: a {}x{} rendering for a {}x{} scene depth (both CV_32FC1)",
-                                 rendering.depth.cols, rendering.depth.rows, scene_depth_m.cols, scene_depth_m.rows));
+                               const Camera& camera, float diameter, const InitialPoseParams& params,
+                               const cv::Rect& window_in) {
+  const cv::Rect window = window_in.empty() ? cv::Rect(0, 0, scene_depth_m.cols, scene_depth_m.rows) : window_in;
+  if (rendering.depth.size() != window.size() || rendering.depth.type() != CV_32FC1 ||
+      scene_depth_m.type() != CV_32FC1 || (window & cv::Rect(0, 0, scene_depth_m.cols, scene_depth_m.rows)) != window)
+    throw InputError(fmt::format("initial translation: a {}x{} rendering for a {}x{} window of a {}x{} scene depth "
+                                 "(both CV_32FC1)",
+                                 rendering.depth.cols, rendering.depth.rows, window.width, window.height,
+                                 scene_depth_m.cols, scene_depth_m.rows));
   const float band = params.depth_band_fraction * diameter;
   auto backProject = [&](int u, int v, float z) {
     return Eigen::Vector3f(static_cast<float>((u - camera.cx) / camera.fx) * z,
@@ -129,21 +162,22 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
   cv::Rect box;  // the rendered object's pixels
   float z_min = std::numeric_limits<float>::max(), z_max = 0.f;
   const Eigen::Matrix3f R_inv = rendered.R.transpose();
-  for (int v = 0; v < rendering.depth.rows; ++v) {
-    const float* zr = rendering.depth.ptr<float>(v);
+  for (int v = window.y; v < window.y + window.height; ++v) {
+    const float* zr = rendering.depth.ptr<float>(v - window.y);
     const float* zs = scene_depth_m.ptr<float>(v);
-    for (int u = 0; u < rendering.depth.cols; ++u) {
-      if (!(zr[u] > 0.f)) continue;
+    for (int u = window.x; u < window.x + window.width; ++u) {
+      const float z = zr[u - window.x];
+      if (!(z > 0.f)) continue;
       ++out.mask_pixels;
       box |= cv::Rect(u, v, 1, 1);
-      z_min = std::min(z_min, zr[u]);
-      z_max = std::max(z_max, zr[u]);
-      const Eigen::Vector3f pm = backProject(u, v, zr[u]);
+      z_min = std::min(z_min, z);
+      z_max = std::max(z_max, z);
+      const Eigen::Vector3f pm = backProject(u, v, z);
       out.model_points.push_back(R_inv * (pm - rendered.t));
-      if (!(zs[u] > 0.f) || zs[u] < zr[u] - band) continue;  // no depth, or an occluder
+      if (!(zs[u] > 0.f) || zs[u] < z - band) continue;  // no depth, or an occluder
       model_sum += pm.cast<double>();
       ++model_count;
-      if (zs[u] > zr[u] + band) continue;  // background seen past the object's edge
+      if (zs[u] > z + band) continue;  // background seen past the object's edge
       scene_sum += backProject(u, v, zs[u]).cast<double>();
       ++out.object_pixels;
     }

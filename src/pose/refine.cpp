@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 
+#include "pose/nearest_neighbours.hpp"
 #include "pose/point_cloud.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/geometry.hpp"
@@ -120,11 +121,10 @@ bool smallStep(const Eigen::Matrix4f& step, double epsilon) {
 /// pairs only, which trims clutter and occluded parts and tightens the fit.
 class AdaptiveIcp {
  public:
-  /// model: object frame; scene: camera frame (the k-d tree is built once, per call).
-  AdaptiveIcp(Cloud::ConstPtr model, Cloud::ConstPtr scene, std::size_t min_pairs)
-      : model_(std::move(model)), scene_(std::move(scene)), min_pairs_(min_pairs) {
-    tree_.setInputCloud(scene_);
-  }
+  /// model: object frame; scene: camera frame (the search grid is built once, per call, with
+  /// cells of `cell` metres: the voxel filter's leaf size, about one scene point a cell).
+  AdaptiveIcp(Cloud::ConstPtr model, Cloud::ConstPtr scene, std::size_t min_pairs, float cell)
+      : model_(std::move(model)), scene_(std::move(scene)), min_pairs_(min_pairs), nearest_scene_(fromPcl(*scene_), cell) {}
 
   /// Runs one stage from cam_T_model. Returns true when it converged within the limit;
   /// false when it hit the limit or ran out of pairs (cam_T_model keeps the last pose).
@@ -165,10 +165,8 @@ class AdaptiveIcp {
     dist_sqr_.resize(moved_.size());
     float max_sqr = 0.f;
     for (std::size_t i = 0; i < moved_.size(); ++i) {
-      tree_.nearestKSearch(moved_[i], 1, k_index_, k_sqr_);
-      nearest_[i] = k_index_[0];
-      dist_sqr_[i] = k_sqr_[0];
-      max_sqr = std::max(max_sqr, k_sqr_[0]);
+      nearest_[i] = nearest_scene_.nearest(moved_[i].getVector3fMap(), dist_sqr_[i]);
+      max_sqr = std::max(max_sqr, dist_sqr_[i]);
     }
     const float threshold = fraction > 0.f ? fraction * std::sqrt(max_sqr) : fixed;
     const float threshold_sqr = threshold * threshold;
@@ -191,11 +189,11 @@ class AdaptiveIcp {
 
   Cloud::ConstPtr model_, scene_;
   std::size_t min_pairs_;
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
+  NearestNeighbours nearest_scene_;
   pcl::registration::TransformationEstimationSVD<pcl::PointXYZ, pcl::PointXYZ> svd_;
   Cloud moved_;
-  pcl::Indices pairs_src_, pairs_tgt_, nearest_, k_index_;
-  std::vector<float> dist_sqr_, k_sqr_;
+  pcl::Indices pairs_src_, pairs_tgt_, nearest_;
+  std::vector<float> dist_sqr_;
 };
 
 /// Plain pcl::IterativeClosestPoint with a fixed threshold, the baseline. Exposes the
@@ -229,6 +227,24 @@ Pose toPose(const Eigen::Matrix4f& m) {
 }
 
 }  // namespace
+
+std::vector<int> nearestByPclKdTree(const PointCloud& cloud, const PointCloud& queries) {
+  // toPcl drops non-finite points: map the tree's indices back to the input's.
+  std::vector<int> kept;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (cloud[i].allFinite()) kept.push_back(static_cast<int>(i));
+  std::vector<int> out(queries.size(), -1);
+  if (kept.empty()) return out;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(toPcl(cloud));
+  pcl::Indices index;
+  std::vector<float> dist_sqr;
+  for (std::size_t q = 0; q < queries.size(); ++q)
+    if (queries[q].allFinite() && tree.nearestKSearch(pcl::PointXYZ(queries[q].x(), queries[q].y(), queries[q].z()), 1,
+                                                      index, dist_sqr) == 1)
+      out[q] = kept[static_cast<std::size_t>(index[0])];
+  return out;
+}
 
 PointCloud voxelFilter(const PointCloud& cloud, float voxel) {
   if (!std::isfinite(voxel)) throw InputError(fmt::format("voxel size must be finite, got {}", voxel));
@@ -265,7 +281,8 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
 
   t0 = Clock::now();
   Eigen::Matrix4f cam_T_model = toMatrix(initial);
-  AdaptiveIcp icp(model, scene, min_points);
+  // The grid's cell: the voxel filter's leaf (one scene point a cell), 4 mm without a filter.
+  AdaptiveIcp icp(model, scene, min_points, params.voxel_size > 0.f ? params.voxel_size : 0.004f);
   if (params.fixed_max_correspondence_m > 0.f) {
     FixedIcp fixed;
     fixed.setInputSource(model);

@@ -5,6 +5,7 @@
 // from coarse to fine with a correspondence threshold recomputed at every iteration.
 // PCL does the work; it stays inside src/pose/refine.cpp.
 #include <cstddef>
+#include <vector>
 
 #include "pose/point_cloud.hpp"
 #include "vkpose/config.hpp"
@@ -49,6 +50,10 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
 /// InputError unless the MLS radius is positive and finite, the polynomial order >= 0 and the
 /// seed voxel >= 0 and finite (src/pipeline/params.cpp, beside the other parameter checks).
 void validateMls(float radius, int order, float seed_voxel);
+
+/// For each query, the index of its nearest point of `cloud` by PCL's k-d tree (KdTreeFLANN),
+/// -1 for a non-finite query: the peer that NearestNeighbours, ICP's search, is tested against.
+std::vector<int> nearestByPclKdTree(const PointCloud& cloud, const PointCloud& queries);
 
 /// Voxel grid: one point per occupied cube of side `voxel` (metres), the centroid of its
 /// points. voxel <= 0 returns the finite points unchanged.

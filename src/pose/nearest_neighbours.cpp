@@ -1,0 +1,123 @@
+#include "pose/nearest_neighbours.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+NearestNeighbours::Grid::Grid(const PointCloud& points, float cell_size, std::size_t max_cells) {
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+  for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // Cells grow until the grid fits max_cells (a crop is centimetres wide, so only absurd input
+  // gets there). One spare layer: a point on the box's far face needs no clamping, so every
+  // point sits in the cell its coordinates say (the search's bound relies on it).
+  const Eigen::Vector3f extent = hi - lo;
+  for (;;) {
+    const Eigen::Vector3f n = (extent / cell_size).array().floor() + 2.f;
+    if (n.maxCoeff() <= float(1 << 20) && double(n.x()) * n.y() * n.z() <= double(max_cells)) {
+      nx = static_cast<int>(n.x()), ny = static_cast<int>(n.y()), nz = static_cast<int>(n.z());
+      break;
+    }
+    cell_size *= 2.f;
+  }
+  cell = cell_size;
+  inv_cell = 1.f / cell_size;
+  origin = lo;
+  const std::size_t cells = std::size_t(nx) * std::size_t(ny) * std::size_t(nz);
+  std::vector<std::size_t> cell_of(points.size());
+  start.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f c = ((points[i] - origin) * inv_cell).array().floor();
+    cell_of[i] = (std::size_t(c.z()) * std::size_t(ny) + std::size_t(c.y())) * std::size_t(nx) + std::size_t(c.x());
+    ++start[cell_of[i] + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  order.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) order[fill[cell_of[i]]++] = static_cast<int>(i);
+}
+
+bool NearestNeighbours::Grid::search(const PointCloud& sorted, const Eigen::Vector3f& q, int& best,
+                                     float& best_sqr) const {
+  // q's cell, possibly outside the grid (clamped far enough out not to overflow).
+  const Eigen::Vector3f f = ((q - origin) * inv_cell).array().floor().cwiseMax(-4096.f).cwiseMin(float(1 << 21));
+  const int cx = static_cast<int>(f.x()), cy = static_cast<int>(f.y()), cz = static_cast<int>(f.z());
+  for (int k = 0; k <= kMaxRing; ++k) {
+    // The shell of cells at Chebyshev distance k from q's cell, within the grid.
+    for (int z = std::max(cz - k, 0); z <= std::min(cz + k, nz - 1); ++z)
+      for (int y = std::max(cy - k, 0); y <= std::min(cy + k, ny - 1); ++y) {
+        const bool inner_zy = std::abs(z - cz) < k && std::abs(y - cy) < k;
+        const std::size_t row = (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx);
+        for (int x = std::max(cx - k, 0); x <= std::min(cx + k, nx - 1); ++x) {
+          if (inner_zy && std::abs(x - cx) < k) {  // inside the shell: on to its far face
+            x = cx + k - 1;
+            continue;
+          }
+          for (std::uint32_t i = start[row + std::size_t(x)], end = start[row + std::size_t(x) + 1]; i < end; ++i) {
+            const float d = (sorted[i] - q).squaredNorm();
+            if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
+          }
+        }
+      }
+    // Every point not yet seen lies in a cell k + 1 or more away: farther than k cells from q.
+    const float reach = static_cast<float>(k) * cell;
+    if (best >= 0 && best_sqr <= reach * reach) return true;
+  }
+  return false;
+}
+
+NearestNeighbours::NearestNeighbours(const PointCloud& points, float cell, std::size_t max_cells) {
+  if (!(cell > 0.f) || !std::isfinite(cell))
+    throw InputError(fmt::format("nearest-neighbour grid: the cell size must be positive and finite, got {}", cell));
+  PointCloud finite;
+  std::vector<int> index;
+  finite.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i].allFinite()) finite.push_back(points[i]), index.push_back(static_cast<int>(i));
+  if (finite.empty()) return;
+  fine_ = Grid(finite, cell, max_cells);
+  points_.reserve(finite.size());
+  for (const int i : fine_.order) {
+    points_.push_back(finite[static_cast<std::size_t>(i)]);
+    original_.push_back(index[static_cast<std::size_t>(i)]);
+  }
+  coarse_ = Grid(points_, cell * kCoarse, max_cells);
+  coarse_sorted_.reserve(points_.size());
+  coarse_rank_.resize(points_.size());
+  for (std::size_t k = 0; k < coarse_.order.size(); ++k) {
+    coarse_sorted_.push_back(points_[static_cast<std::size_t>(coarse_.order[k])]);
+    coarse_rank_[static_cast<std::size_t>(coarse_.order[k])] = static_cast<int>(k);
+  }
+}
+
+int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const {
+  dist_sqr = std::numeric_limits<float>::infinity();
+  if (points_.empty() || !q.allFinite()) return -1;
+  int best = -1;
+  float best_sqr = std::numeric_limits<float>::infinity();
+  if (!fine_.search(points_, q, best, best_sqr)) {
+    // The fine grid's best is a candidate for the coarse one, as an index into its order.
+    int coarse_best = -1;
+    if (best >= 0) coarse_best = coarse_rank_[static_cast<std::size_t>(best)];
+    if (coarse_.search(coarse_sorted_, q, coarse_best, best_sqr)) {
+      best = coarse_.order[static_cast<std::size_t>(coarse_best)];
+    } else {
+      ++full_scans_;
+      best = -1;
+      best_sqr = std::numeric_limits<float>::infinity();
+      for (std::size_t i = 0; i < points_.size(); ++i) {
+        const float d = (points_[i] - q).squaredNorm();
+        if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
+      }
+    }
+  }
+  dist_sqr = best_sqr;
+  return original_[static_cast<std::size_t>(best)];
+}
+
+}  // namespace vkpose
