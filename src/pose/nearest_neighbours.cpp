@@ -120,4 +120,27 @@ int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const 
   return original_[static_cast<std::size_t>(best)];
 }
 
+void NearestNeighbours::within(const Eigen::Vector3f& q, float radius, std::vector<int>& out) const {
+  if (points_.empty() || !q.allFinite() || !(radius >= 0.f)) return;
+  const Grid& g = fine_;
+  const Eigen::Vector3f lo = ((q.array() - radius - g.origin.array()) * g.inv_cell).floor().matrix();
+  const Eigen::Vector3f hi = ((q.array() + radius - g.origin.array()) * g.inv_cell).floor().matrix();
+  // The overlapped cells, clamped to the grid before the casts (q may be anywhere).
+  auto range = [](float a, float b, int n, int& i0, int& i1) {
+    i0 = static_cast<int>(std::clamp(a, 0.f, float(n)));
+    i1 = static_cast<int>(std::clamp(b, -1.f, float(n - 1)));
+    return i0 <= i1;
+  };
+  int x0, x1, y0, y1, z0, z1;
+  if (!range(lo.x(), hi.x(), g.nx, x0, x1) || !range(lo.y(), hi.y(), g.ny, y0, y1) || !range(lo.z(), hi.z(), g.nz, z0, z1))
+    return;
+  const float r2 = radius * radius;
+  for (int z = z0; z <= z1; ++z)
+    for (int y = y0; y <= y1; ++y) {
+      const std::size_t row = (std::size_t(z) * std::size_t(g.ny) + std::size_t(y)) * std::size_t(g.nx);
+      for (std::uint32_t i = g.start[row + std::size_t(x0)], end = g.start[row + std::size_t(x1) + 1]; i < end; ++i)
+        if ((points_[i] - q).squaredNorm() <= r2) out.push_back(original_[i]);
+    }
+}
+
 }  // namespace vkpose

@@ -27,6 +27,11 @@ class NearestNeighbours {
   /// every point.
   int nearest(const Eigen::Vector3f& q, float& dist_sqr) const;
 
+  /// Indices of the points within `radius` of q (squared distance <= radius^2), appended to
+  /// `out` in no particular order. Scans the fine grid's cells that the ball overlaps, so a
+  /// cell about the radius's size suits (MLS's neighbourhoods).
+  void within(const Eigen::Vector3f& q, float radius, std::vector<int>& out) const;
+
   std::size_t size() const { return points_.size(); }
   /// Queries answered by the whole-cloud scan since construction (for tests and profiles).
   std::size_t fullScans() const { return full_scans_; }

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <unordered_set>
 
 #include <Eigen/Geometry>
 #include <fmt/core.h>
@@ -64,28 +63,15 @@ Cloud::Ptr voxelPcl(const Cloud::Ptr& in, float voxel) {
   return out;
 }
 
-/// The first point of each occupied voxel, in input order.
-pcl::IndicesPtr voxelSeeds(const Cloud& cloud, float voxel) {
-  auto seeds = pcl::make_shared<pcl::Indices>();
-  std::unordered_set<std::uint64_t> taken;
-  taken.reserve(cloud.size());
-  const float inv = 1.f / voxel;
-  auto cell = [inv](float v) {  // 21 bits per axis: +-4 km at 4 mm, far beyond any crop
-    return std::uint64_t(std::int64_t(std::clamp(std::floor(v * inv), -1048576.f, 1048575.f)) + 1048576);
-  };
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const auto& p = cloud[i];
-    if (taken.insert(cell(p.x) | cell(p.y) << 21 | cell(p.z) << 42).second)
-      seeds->push_back(static_cast<pcl::index_t>(i));
-  }
-  return seeds;
-}
-
 Cloud::Ptr mlsPcl(const Cloud::Ptr& in, float radius, int order, float seed_voxel) {
   if (in->empty()) return in;
   pcl::MovingLeastSquares<pcl::PointXYZ, pcl::PointXYZ> mls;  // one thread: callers run hypotheses in parallel
   mls.setInputCloud(in);
-  if (seed_voxel > 0.f) mls.setIndices(voxelSeeds(*in, seed_voxel));  // neighbourhoods still use all points
+  if (seed_voxel > 0.f) {  // neighbourhoods still use all points
+    auto seeds = pcl::make_shared<pcl::Indices>();
+    for (const std::size_t i : voxelSeedIndices(fromPcl(*in), seed_voxel)) seeds->push_back(static_cast<pcl::index_t>(i));
+    mls.setIndices(seeds);
+  }
   mls.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(false));
   mls.setSearchRadius(radius);
   mls.setPolynomialOrder(order);
@@ -251,7 +237,7 @@ PointCloud voxelFilter(const PointCloud& cloud, float voxel) {
   return fromPcl(*voxelPcl(toPcl(cloud), voxel));
 }
 
-PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel) {
+PointCloud smoothMlsPcl(const PointCloud& scene, float radius, int order, float seed_voxel) {
   validateMls(radius, order, seed_voxel);
   return fromPcl(*mlsPcl(toPcl(scene), radius, order, seed_voxel));
 }
@@ -263,10 +249,9 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
   result.pose = initial;
 
   auto t0 = Clock::now();
-  Cloud::Ptr scene = toPcl(scene_points);
-  if (params.mls)
-    scene = mlsPcl(scene, params.mls_radius, params.mls_polynomial_order,
-                   params.mls_at_voxel_seeds ? params.voxel_size : 0.f);
+  Cloud::Ptr scene = toPcl(params.mls ? smoothMls(scene_points, params.mls_radius, params.mls_polynomial_order,
+                                                  params.mls_at_voxel_seeds ? params.voxel_size : 0.f)
+                                      : scene_points);
   result.mls_ms = msSince(t0);
 
   t0 = Clock::now();

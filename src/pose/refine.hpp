@@ -42,10 +42,17 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
                         const RefineParams& params = {});
 
 /// Moving least squares: each point projected onto a polynomial of `order` fitted to its
-/// neighbours within `radius` (metres). Points with fewer than 3 neighbours are dropped.
-/// seed_voxel > 0: only the first point of each voxel of that size is fitted and returned
-/// (its neighbourhood still uses every point).
+/// neighbours within `radius` (metres), weighted by exp(-d^2 / radius^2) (PCL's
+/// MovingLeastSquares with SIMPLE projection; src/pose/mls.cpp). Points with fewer than 3
+/// neighbours are dropped, as are non-finite points. seed_voxel > 0: only the first point of
+/// each voxel of that size is fitted and returned (its neighbourhood still uses every point).
 PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f);
+
+/// The same with pcl::MovingLeastSquares and its k-d tree: the peer smoothMls is tested against.
+PointCloud smoothMlsPcl(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f);
+
+/// Indices of the first point of each occupied voxel of size `voxel`, in input order (MLS's seeds).
+std::vector<std::size_t> voxelSeedIndices(const PointCloud& cloud, float voxel);
 
 /// InputError unless the MLS radius is positive and finite, the polynomial order >= 0 and the
 /// seed voxel >= 0 and finite (src/pipeline/params.cpp, beside the other parameter checks).

@@ -1,0 +1,108 @@
+// Moving least squares smoothing of the scene crop (docs/pipeline.md, stage 7), PCL's
+// MovingLeastSquares (projection SIMPLE, no upsampling) computed without PCL: the
+// neighbourhoods come from a grid of radius-sized cells instead of a k-d tree, and the
+// polynomial's normal equations are summed in place instead of through per-point dynamic
+// matrices. The same arithmetic otherwise, so the same points to rounding
+// (Mls.MatchesPclsMovingLeastSquares); about 4x faster, and MLS was half the pose stages.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_set>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "pose/nearest_neighbours.hpp"
+#include "pose/refine.hpp"
+
+namespace vkpose {
+
+std::vector<std::size_t> voxelSeedIndices(const PointCloud& cloud, float voxel) {
+  std::vector<std::size_t> seeds;
+  std::unordered_set<std::uint64_t> taken;
+  taken.reserve(cloud.size());
+  const float inv = 1.f / voxel;
+  auto cell = [inv](float v) {  // 21 bits per axis: +-4 km at 4 mm, far beyond any crop
+    return std::uint64_t(std::int64_t(std::clamp(std::floor(v * inv), -1048576.f, 1048575.f)) + 1048576);
+  };
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto& p = cloud[i];
+    if (taken.insert(cell(p.x()) | cell(p.y()) << 21 | cell(p.z()) << 42).second) seeds.push_back(i);
+  }
+  return seeds;
+}
+
+PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel) {
+  validateMls(radius, order, seed_voxel);
+  PointCloud points;  // the finite points, as PCL's input would hold them
+  points.reserve(scene.size());
+  for (const auto& p : scene)
+    if (p.allFinite()) points.push_back(p);
+  if (points.empty()) return {};
+  std::vector<std::size_t> seeds;
+  if (seed_voxel > 0.f) {
+    seeds = voxelSeedIndices(points, seed_voxel);
+  } else {
+    seeds.resize(points.size());
+    for (std::size_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
+  }
+  const NearestNeighbours grid(points, radius);
+  const int coefficients = (order + 1) * (order + 2) / 2;
+  const double sqr_gauss = double(radius) * double(radius);  // PCL's default Gaussian parameter
+  Eigen::MatrixXd normal_matrix(coefficients, coefficients);
+  Eigen::VectorXd rhs(coefficients), terms(coefficients);
+  std::vector<int> nn;
+  PointCloud out;
+  out.reserve(seeds.size());
+  for (const std::size_t s : seeds) {
+    const Eigen::Vector3d q = points[s].cast<double>();
+    nn.clear();
+    grid.within(points[s], radius, nn);
+    if (nn.size() < 3) continue;  // PCL drops these
+    // The neighbourhood's plane: centroid and the covariance's least eigenvector.
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const int i : nn) centroid += points[static_cast<std::size_t>(i)].cast<double>();
+    centroid /= static_cast<double>(nn.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const int i : nn) {
+      const Eigen::Vector3d d = points[static_cast<std::size_t>(i)].cast<double>() - centroid;
+      covariance.noalias() += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+    const Eigen::Vector3d normal = eigen.eigenvectors().col(0);
+    if (!normal.allFinite()) {
+      out.push_back(points[s]);  // PCL keeps the input point
+      continue;
+    }
+    // The query projected onto the plane; the polynomial's height at it moves it onto the
+    // surface (a flipped normal flips the heights too, and a full polynomial in (u, v) is the
+    // same in any tangent frame, so the point does not depend on either choice).
+    const Eigen::Vector3d mean = q - (q - centroid).dot(normal) * normal;
+    Eigen::Vector3d result = mean;
+    if (order > 1 && static_cast<int>(nn.size()) >= coefficients) {
+      const Eigen::Vector3d v_axis = normal.unitOrthogonal(), u_axis = normal.cross(v_axis);
+      normal_matrix.setZero();
+      rhs.setZero();
+      for (const int i : nn) {
+        const Eigen::Vector3d d = points[static_cast<std::size_t>(i)].cast<double>() - mean;
+        const double weight = std::exp(-d.squaredNorm() / sqr_gauss);
+        const double u = d.dot(u_axis), v = d.dot(v_axis), f = d.dot(normal);
+        int j = 0;  // PCL's order of the terms: u^a v^b, a outer, b inner
+        double u_pow = 1;
+        for (int a = 0; a <= order; ++a, u_pow *= u) {
+          double v_pow = 1;
+          for (int b = 0; b <= order - a; ++b, v_pow *= v) terms(j++) = u_pow * v_pow;
+        }
+        normal_matrix.selfadjointView<Eigen::Upper>().rankUpdate(terms, weight);
+        rhs.noalias() += (weight * f) * terms;
+      }
+      const Eigen::VectorXd c = normal_matrix.selfadjointView<Eigen::Upper>().llt().solve(rhs);
+      if (std::isfinite(c(0))) result = mean + c(0) * normal;
+    }
+    const Eigen::Vector3f p = result.cast<float>();
+    if (p.allFinite()) out.push_back(p);  // a degenerate neighbourhood can give a NaN point
+  }
+  return out;
+}
+
+}  // namespace vkpose
