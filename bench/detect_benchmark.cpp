@@ -203,6 +203,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   std::vector<double> totals, match_ms;
   std::vector<std::size_t> detections;  // per timed frame, to compare with frames in flight
   uint64_t pairs = 0, pruned = 0, skipped = 0;
+  double refine_cpu_ms = 0, refined = 0, accepted = 0;
   for (int i = 0; i < o.warmup; ++i) {
     const DetectionResult r = detector.detect(frames[0].frame, frames[0].camera);
     for (const auto& [stage, ms] : r.timings_ms)
@@ -233,6 +234,9 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
     report.mean_hypotheses += static_cast<double>(r.hypotheses) / o.frames;
     report.mean_detections += static_cast<double>(r.detections.size()) / o.frames;
     detections.push_back(r.detections.size());
+    refine_cpu_ms += r.refine_cpu_ms;
+    refined += static_cast<double>(r.refined_candidates);
+    accepted += static_cast<double>(r.detections.size());
     report_progress("detect", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
   }
   for (const auto& [group, names] : stageGroups())
@@ -245,6 +249,9 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
     report.pruned_share = static_cast<double>(pruned) / static_cast<double>(pairs);
     report.skipped_share = static_cast<double>(skipped) / static_cast<double>(pairs);
   }
+  report.mean_refined = refined / o.frames;
+  report.refine_ms_per_candidate = refined > 0 ? refine_cpu_ms / refined : 0.0;
+  report.refined_per_detection = accepted > 0 ? refined / accepted : 0.0;
   double total_sum = 0;
   for (const double t : totals) total_sum += t;
   report.stages.push_back({"total", median(totals), percentile(totals, 95), total_sum / o.frames});
@@ -309,6 +316,10 @@ std::string formatDetectReport(const DetectBenchReport& r) {
     out += fmt::format("{:<14} {:>12.1f} {:>12.1f} {:>12.1f}\n", s.stage, s.median_ms, s.p95_ms, s.mean_ms);
   out += fmt::format("\n{:.3f} frames/s; per frame {:.0f} matches, {:.0f} hypotheses, {:.1f} detections\n",
                      r.frames_per_s, r.mean_matches, r.mean_hypotheses, r.mean_detections);
+  if (r.mean_refined > 0)
+    out += fmt::format("pose stages: {:.1f} candidates refined a frame, {:.1f} CPU ms each (MLS, ICP, verification on "
+                       "one core), {:.1f} refined per detection\n",
+                       r.mean_refined, r.refine_ms_per_candidate, r.refined_per_detection);
   out += r.pruned_share > 0 || r.skipped_share > 0
              ? fmt::format("depth-guided pruning: {:.1f} % of the (template, position) pairs pruned, {:.1f} % skipped "
                            "unread\n",
@@ -346,6 +357,9 @@ nlohmann::json detectReportJson(const DetectBenchReport& r) {
                       {"mean_matches", r.mean_matches},
                       {"mean_hypotheses", r.mean_hypotheses},
                       {"mean_detections", r.mean_detections},
+                      {"mean_refined_candidates", r.mean_refined},
+                      {"refine_cpu_ms_per_candidate", r.refine_ms_per_candidate},
+                      {"refined_per_detection", r.refined_per_detection},
                       {"pruned_share", r.pruned_share},
                       {"skipped_share", r.skipped_share},
                       {"memory", {{"peak_rss_bytes", r.peak_rss_bytes},

@@ -24,6 +24,7 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
   auto options = std::make_shared<bench::DetectBenchOptions>();
   auto json_path = std::make_shared<std::string>();
   auto source = std::make_shared<std::string>("auto");
+  auto config = std::make_shared<std::string>();
   sub->add_option("--bank", options->banks, "Template bank (.vkpb); repeat for several objects")->required();
   sub->add_option("--frames", options->frames, "Frames to time (real frames are cycled when there are fewer)")
       ->capture_default_str();
@@ -58,8 +59,10 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
       ->check(CLI::IsMember({"objects", "instances"}));
   sub->add_option("--counts", *counts, "Counts of the sweep (comma separated)")->delimiter(',')->check(CLI::Range(1, 100));
   sub->add_option("--json", *json_path, "Also write the figures as JSON to this file (never overwritten)");
-  return [options, json_path, source, sweep, counts, &global]() {
+  addConfigOption(sub, *config);
+  return [options, json_path, source, sweep, counts, config, &global]() {
     options->source = bench::parseFrameSource(*source);
+    options->params = withConfig(*config, options->params);
     if (!json_path->empty() && std::filesystem::exists(*json_path))
       throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");
     std::unique_ptr<ProgressBar> bar;

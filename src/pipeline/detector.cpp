@@ -286,15 +286,18 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
 
   // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).
   t0 = std::chrono::steady_clock::now();
+  std::vector<double> cpu_ms(n, 0.0);  // per candidate, stages 7-8
   std::vector<PointCloud> smoothed(n);
   util::parallelFor(
       n,
       [&](std::size_t i) {
         if (!initial[i].ok) return;
+        const auto start = std::chrono::steady_clock::now();
         const RefineParams& rp = refine_params[i];
         smoothed[i] = rp.mls ? smoothMls(initial[i].scene_points, rp.mls_radius, rp.mls_polynomial_order,
-                                         rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f)
+                                         rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f, rp.mls_max_neighbours)
                              : initial[i].scene_points;
+        cpu_ms[i] += msSince(start);
       },
       params_.threads);
   result.timings_ms.emplace_back("mls", msSince(t0));
@@ -304,9 +307,11 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       n,
       [&](std::size_t i) {
         if (!initial[i].ok) return;
+        const auto start = std::chrono::steady_clock::now();
         RefineParams icp_params = refine_params[i];
         icp_params.mls = false;  // done above
         refined[i] = refinePose(initial[i].model_points, smoothed[i], initial[i].pose, icp_params);
+        cpu_ms[i] += msSince(start);
       },
       params_.threads);
   result.timings_ms.emplace_back("icp", msSince(t0));
@@ -321,14 +326,18 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       n,
       [&](std::size_t i) {
         if (!initial[i].ok) return;
+        const auto start = std::chrono::steady_clock::now();
         const PointCloud model = transformed(initial[i].model_points, refined[i].pose);
         const VerifyParams& vp = verify_params[i];
         verified[i] = verifyPose(model, initial[i].scene_points, vp);
         agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
         support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
         explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
+        cpu_ms[i] += msSince(start);
       },
       params_.threads);
+  for (std::size_t i = 0; i < n; ++i)
+    if (initial[i].ok) ++result.refined_candidates, result.refine_cpu_ms += cpu_ms[i];
 
   std::vector<Detection> accepted;
   std::vector<std::vector<int>> accepted_cells;  // explained[i] of accepted[k]

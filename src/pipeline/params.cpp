@@ -55,6 +55,10 @@ void validateRefineParams(const RefineParams& p) {
   if (p.coarse_iterations < 0 || p.fine_iterations < 0)
     throw InputError(fmt::format("ICP iteration limits must be >= 0, got {} and {}", p.coarse_iterations,
                                  p.fine_iterations));
+  if (p.mls_max_neighbours < 0 || p.coarse_max_points < 0)
+    throw InputError(fmt::format("refine.mls_max_neighbours and refine.coarse_max_points must be >= 0 (0: all), got {} "
+                                 "and {}",
+                                 p.mls_max_neighbours, p.coarse_max_points));
   if (!(p.convergence_epsilon >= 0.0))
     throw InputError(fmt::format("ICP convergence epsilon must be >= 0, got {}", p.convergence_epsilon));
   if (!std::isfinite(p.fixed_max_correspondence_m) || p.fixed_max_correspondence_m < 0.f)

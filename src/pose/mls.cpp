@@ -32,7 +32,37 @@ std::vector<std::size_t> voxelSeedIndices(const PointCloud& cloud, float voxel) 
   return seeds;
 }
 
-PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel) {
+namespace {
+/// The weighted least-squares polynomial of `order` in the tangent frame at `mean` through the
+/// neighbourhood's heights along `normal`, evaluated at (0, 0): c_0. N: the number of
+/// coefficients when known at compile time (6 for quadrics: no allocation per point).
+template <int N>
+double polynomialHeight(const PointCloud& points, const std::vector<int>& nn, const Eigen::Vector3d& mean,
+                        const Eigen::Vector3d& normal, int order, double sqr_gauss) {
+  const int coefficients = (order + 1) * (order + 2) / 2;
+  Eigen::Matrix<double, N, N> normal_matrix(coefficients, coefficients);
+  Eigen::Matrix<double, N, 1> rhs(coefficients), terms(coefficients);
+  normal_matrix.setZero();
+  rhs.setZero();
+  const Eigen::Vector3d v_axis = normal.unitOrthogonal(), u_axis = normal.cross(v_axis);
+  for (const int i : nn) {
+    const Eigen::Vector3d d = points[static_cast<std::size_t>(i)].cast<double>() - mean;
+    const double weight = std::exp(-d.squaredNorm() / sqr_gauss);
+    const double u = d.dot(u_axis), v = d.dot(v_axis), f = d.dot(normal);
+    int j = 0;  // PCL's order of the terms: u^a v^b, a outer, b inner
+    double u_pow = 1;
+    for (int a = 0; a <= order; ++a, u_pow *= u) {
+      double v_pow = 1;
+      for (int b = 0; b <= order - a; ++b, v_pow *= v) terms(j++) = u_pow * v_pow;
+    }
+    normal_matrix.template selfadjointView<Eigen::Upper>().rankUpdate(terms, weight);
+    rhs.noalias() += (weight * f) * terms;
+  }
+  return normal_matrix.template selfadjointView<Eigen::Upper>().llt().solve(rhs)(0);
+}
+}  // namespace
+
+PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel, int max_neighbours) {
   validateMls(radius, order, seed_voxel);
   PointCloud points;  // the finite points, as PCL's input would hold them
   points.reserve(scene.size());
@@ -46,11 +76,9 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
     seeds.resize(points.size());
     for (std::size_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
   }
-  const NearestNeighbours grid(points, radius);
+  const NearestNeighbours grid(points, 0.5f * radius);
   const int coefficients = (order + 1) * (order + 2) / 2;
   const double sqr_gauss = double(radius) * double(radius);  // PCL's default Gaussian parameter
-  Eigen::MatrixXd normal_matrix(coefficients, coefficients);
-  Eigen::VectorXd rhs(coefficients), terms(coefficients);
   std::vector<int> nn;
   PointCloud out;
   out.reserve(seeds.size());
@@ -59,6 +87,12 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
     nn.clear();
     grid.within(points[s], radius, nn);
     if (nn.size() < 3) continue;  // PCL drops these
+    if (max_neighbours > 0 && nn.size() > static_cast<std::size_t>(max_neighbours)) {
+      const std::size_t k = (nn.size() + static_cast<std::size_t>(max_neighbours) - 1) / static_cast<std::size_t>(max_neighbours);
+      std::size_t kept = 0;
+      for (std::size_t j = 0; j < nn.size(); j += k) nn[kept++] = nn[j];
+      nn.resize(kept);
+    }
     // The neighbourhood's plane: centroid and the covariance's least eigenvector.
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const int i : nn) centroid += points[static_cast<std::size_t>(i)].cast<double>();
@@ -68,7 +102,8 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
       const Eigen::Vector3d d = points[static_cast<std::size_t>(i)].cast<double>() - centroid;
       covariance.noalias() += d * d.transpose();
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(covariance);  // closed form, as PCL's eigen33
     const Eigen::Vector3d normal = eigen.eigenvectors().col(0);
     if (!normal.allFinite()) {
       out.push_back(points[s]);  // PCL keeps the input point
@@ -80,24 +115,9 @@ PointCloud smoothMls(const PointCloud& scene, float radius, int order, float see
     const Eigen::Vector3d mean = q - (q - centroid).dot(normal) * normal;
     Eigen::Vector3d result = mean;
     if (order > 1 && static_cast<int>(nn.size()) >= coefficients) {
-      const Eigen::Vector3d v_axis = normal.unitOrthogonal(), u_axis = normal.cross(v_axis);
-      normal_matrix.setZero();
-      rhs.setZero();
-      for (const int i : nn) {
-        const Eigen::Vector3d d = points[static_cast<std::size_t>(i)].cast<double>() - mean;
-        const double weight = std::exp(-d.squaredNorm() / sqr_gauss);
-        const double u = d.dot(u_axis), v = d.dot(v_axis), f = d.dot(normal);
-        int j = 0;  // PCL's order of the terms: u^a v^b, a outer, b inner
-        double u_pow = 1;
-        for (int a = 0; a <= order; ++a, u_pow *= u) {
-          double v_pow = 1;
-          for (int b = 0; b <= order - a; ++b, v_pow *= v) terms(j++) = u_pow * v_pow;
-        }
-        normal_matrix.selfadjointView<Eigen::Upper>().rankUpdate(terms, weight);
-        rhs.noalias() += (weight * f) * terms;
-      }
-      const Eigen::VectorXd c = normal_matrix.selfadjointView<Eigen::Upper>().llt().solve(rhs);
-      if (std::isfinite(c(0))) result = mean + c(0) * normal;
+      const double height = order == 2 ? polynomialHeight<6>(points, nn, mean, normal, order, sqr_gauss)
+                                       : polynomialHeight<Eigen::Dynamic>(points, nn, mean, normal, order, sqr_gauss);
+      if (std::isfinite(height)) result = mean + height * normal;
     }
     const Eigen::Vector3f p = result.cast<float>();
     if (p.allFinite()) out.push_back(p);  // a degenerate neighbourhood can give a NaN point

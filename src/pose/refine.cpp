@@ -112,6 +112,9 @@ class AdaptiveIcp {
   AdaptiveIcp(Cloud::ConstPtr model, Cloud::ConstPtr scene, std::size_t min_pairs, float cell)
       : model_(std::move(model)), scene_(std::move(scene)), min_pairs_(min_pairs), nearest_scene_(fromPcl(*scene_), cell) {}
 
+  /// The model points the next stages pair (object frame).
+  void setModel(Cloud::ConstPtr model) { model_ = std::move(model); }
+
   /// Runs one stage from cam_T_model. Returns true when it converged within the limit;
   /// false when it hit the limit or ran out of pairs (cam_T_model keeps the last pose).
   bool stage(float fraction, int max_iterations, double epsilon, Eigen::Matrix4f& cam_T_model, int& iterations) {
@@ -250,7 +253,8 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
 
   auto t0 = Clock::now();
   Cloud::Ptr scene = toPcl(params.mls ? smoothMls(scene_points, params.mls_radius, params.mls_polynomial_order,
-                                                  params.mls_at_voxel_seeds ? params.voxel_size : 0.f)
+                                                  params.mls_at_voxel_seeds ? params.voxel_size : 0.f,
+                                                  params.mls_max_neighbours)
                                       : scene_points);
   result.mls_ms = msSince(t0);
 
@@ -283,9 +287,19 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
     result.max_correspondence_m = params.fixed_max_correspondence_m;
     result.fitness = icp.fitnessFixed(cam_T_model, result.max_correspondence_m, result.correspondences);
   } else {
-    // The fine stage runs even when the coarse one hit its limit: it starts closer anyway.
+    // The coarse stage only has to bring the pose near: a subsample of the model does that
+    // at a fraction of the pairing (coarse_max_points). The fine stage runs even when the
+    // coarse one hit its limit: it starts closer anyway.
+    const auto limit = static_cast<std::size_t>(params.coarse_max_points);
+    if (limit > 0 && model->size() > limit) {
+      const std::size_t k = (model->size() + limit - 1) / limit;
+      auto thinned = pcl::make_shared<Cloud>();
+      for (std::size_t i = 0; i < model->size(); i += k) thinned->push_back((*model)[i]);
+      if (thinned->size() >= min_points) icp.setModel(thinned);
+    }
     result.coarse_converged = icp.stage(params.coarse_fraction, params.coarse_iterations,
                                         params.convergence_epsilon, cam_T_model, result.iterations);
+    icp.setModel(model);
     const bool fine = icp.stage(params.fine_fraction, params.fine_iterations, params.convergence_epsilon,
                                 cam_T_model, result.iterations);
     result.converged = params.fine_iterations > 0 ? fine : result.coarse_converged;  // 0: stage skipped

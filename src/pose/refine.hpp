@@ -46,7 +46,9 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
 /// MovingLeastSquares with SIMPLE projection; src/pose/mls.cpp). Points with fewer than 3
 /// neighbours are dropped, as are non-finite points. seed_voxel > 0: only the first point of
 /// each voxel of that size is fitted and returned (its neighbourhood still uses every point).
-PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f);
+/// max_neighbours > 0: a larger neighbourhood is thinned to every k-th point, k the smallest
+/// that leaves at most max_neighbours (the fit's cost follows the points it sums).
+PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f, int max_neighbours = 0);
 
 /// The same with pcl::MovingLeastSquares and its k-d tree: the peer smoothMls is tested against.
 PointCloud smoothMlsPcl(const PointCloud& scene, float radius, int order, float seed_voxel = 0.f);
