@@ -361,6 +361,10 @@ leaves the config as it was.)")
                              "pairs whose scene depth does not suit the template's training distance")
       .def_property_readonly("match_pairs_skipped", [](const PyResult& r) { return r.r.match_pairs_skipped; },
                              "pruned pairs the GPU skipped without reading memory")
+      .def_property_readonly("refined_candidates", [](const PyResult& r) { return r.r.refined_candidates; },
+                             "pose candidates that stages 7-8 refined and verified")
+      .def_property_readonly("refine_cpu_ms", [](const PyResult& r) { return r.r.refine_cpu_ms; },
+                             "their CPU milliseconds together (MLS, ICP, verification; each on one core)")
       .def_property_readonly("warnings", [](const PyResult& r) { return r.r.warnings; })
       .def_property_readonly("camera", [](const PyResult& r) { return r.frame->camera; })
       .def(
