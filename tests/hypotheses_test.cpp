@@ -1,7 +1,9 @@
 // Stages 3-5: template clustering, the cluster score (GPU against the CPU reference) and
 // non-maximum suppression, on hand-made inputs and on synthetic scenes with known instances.
 #include <cmath>
+#include <map>
 #include <random>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -87,6 +89,69 @@ Hypothesis scored(float x, float y, float score, int bank = 0) {
   h.score = score;
   h.distance = 0.5f;
   return h;
+}
+
+// The sort-based clustering against the plain definition (a map per cell of the best match per
+// template, the first of equals), on 20,000 random matches of two banks with repeated
+// templates, equal similarities and cells at the image's edge: the same hypotheses, members and
+// order, bit for bit.
+TEST(Clustering, EqualsTheMapOfBestMatchesPerTemplate) {
+  const std::vector<TemplateBank> banks{fakeBank(40, {0.5f, 0.7f}), fakeBank(25, {0.6f})};
+  std::mt19937 rng(5);
+  std::vector<Match> matches;
+  for (int i = 0; i < 20000; ++i) {
+    Match m;
+    m.template_id = std::uniform_int_distribution<int>(0, 64)(rng);
+    m.x = std::uniform_int_distribution<int>(-20, 90)(rng);
+    m.y = std::uniform_int_distribution<int>(-20, 60)(rng);
+    m.similarity = 80.f + 0.5f * static_cast<float>(std::uniform_int_distribution<int>(0, 20)(rng));  // many ties
+    matches.push_back(m);
+  }
+  ClusterParams params;
+  params.min_templates = 3;
+  const TemplateIndex index(banks);
+  using Key = std::tuple<int, int, int, long>;
+  std::map<Key, std::map<int, ClusterMember>> groups;
+  for (const Match& m : matches) {
+    const int b = index.bankOf(m.template_id), local = m.template_id - index.first[static_cast<std::size_t>(b)];
+    const BankTemplate& t = banks[static_cast<std::size_t>(b)].templates[static_cast<std::size_t>(local)];
+    const ClusterMember member{local, m.x, m.y, m.similarity, static_cast<float>(m.x) + t.anchor_x,
+                               static_cast<float>(m.y) + t.anchor_y};
+    const float step = static_cast<float>(params.position_step_px);
+    auto [it, inserted] = groups[{b, static_cast<int>(std::floor(member.centre_y / step)),
+                                  static_cast<int>(std::floor(member.centre_x / step)), std::lround(t.distance * 1e4f)}]
+                              .try_emplace(local, member);
+    if (!inserted && member.similarity > it->second.similarity) it->second = member;
+  }
+  std::vector<Hypothesis> expected;
+  for (const auto& [key, members] : groups) {
+    if (static_cast<int>(members.size()) < params.min_templates) continue;
+    Hypothesis h;
+    h.bank = std::get<0>(key);
+    h.distance = static_cast<float>(std::get<3>(key)) * 1e-4f;
+    double sx = 0, sy = 0;
+    for (const auto& [local, m] : members) sx += m.centre_x, sy += m.centre_y, h.members.push_back(m);
+    h.x = static_cast<float>(sx / static_cast<double>(members.size()));
+    h.y = static_cast<float>(sy / static_cast<double>(members.size()));
+    std::stable_sort(h.members.begin(), h.members.end(),
+                     [](const ClusterMember& a, const ClusterMember& b) { return a.similarity > b.similarity; });
+    expected.push_back(std::move(h));
+  }
+  const std::vector<Hypothesis> got = clusterTemplates(matches, banks, params);
+  ASSERT_GT(expected.size(), 50u);
+  ASSERT_EQ(got.size(), expected.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].bank, expected[i].bank);
+    EXPECT_EQ(got[i].x, expected[i].x);
+    EXPECT_EQ(got[i].y, expected[i].y);
+    EXPECT_EQ(got[i].distance, expected[i].distance);
+    ASSERT_EQ(got[i].members.size(), expected[i].members.size()) << i;
+    for (std::size_t k = 0; k < got[i].members.size(); ++k) {
+      const ClusterMember &a = got[i].members[k], &b = expected[i].members[k];
+      EXPECT_TRUE(a.template_index == b.template_index && a.x == b.x && a.y == b.y && a.similarity == b.similarity)
+          << "hypothesis " << i << ", member " << k;
+    }
+  }
 }
 
 TEST(Nms, KeepsTheBestWithinTheRadiusAroundFixedCentres) {

