@@ -47,7 +47,7 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
 
   // Key: bank, cell row, cell column, training distance (whole 0.1 mm, so equal radii group
   // exactly). Per key, the best match of each template (the first of equals). Sorting one flat
-  // array instead of filling a map of maps: LM-O frames bring 300,000 matches (360 -> 40 ms).
+  // array instead of filling a map of maps: LM-O frames bring 300,000 matches (364 -> 131 ms).
   using Key = std::tuple<int, int, int, long>;
   struct Entry {
     Key key;

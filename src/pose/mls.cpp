@@ -1,6 +1,6 @@
 // Moving least squares smoothing of the scene crop (docs/pipeline.md, stage 7), PCL's
 // MovingLeastSquares (projection SIMPLE, no upsampling) computed without PCL: the
-// neighbourhoods come from a grid of radius-sized cells instead of a k-d tree, and the
+// neighbourhoods come from a grid of half-radius cells instead of a k-d tree, and the
 // polynomial's normal equations are summed in place instead of through per-point dynamic
 // matrices. The same arithmetic otherwise, so the same points to rounding
 // (Mls.MatchesPclsMovingLeastSquares); about 4x faster, and MLS was half the pose stages.
