@@ -138,6 +138,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups
       {"mls", {"mls"}},
       {"icp", {"icp"}},
       {"verification", {"verification"}},
+      {"symmetries", {"symmetries"}},
   };
   return groups;
 }
@@ -404,7 +405,8 @@ std::vector<DetectSweepRow> runDetectSweep(const DetectBenchOptions& options, De
     row.templates = r.templates;
     for (const auto& st : r.stages) {
       if (st.stage == "total") row.total_ms = st.median_ms;
-      else if (st.stage == "initial_pose" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification")
+      else if (st.stage == "initial_pose" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification" ||
+               st.stage == "symmetries")
         row.pose_ms += st.median_ms;
       else row.match_ms += st.median_ms;
     }

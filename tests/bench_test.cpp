@@ -113,8 +113,9 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   EXPECT_EQ(r.objects, std::vector<std::string>{"box"});
   EXPECT_GT(r.templates, 0u);
   EXPECT_NE(r.frames_from.find("synthetic"), std::string::npos);
-  const std::vector<std::string> stages = {"features", "similarity", "clustering",   "scoring", "nms",
-                                           "initial_pose", "mls",    "icp", "verification", "total"};
+  const std::vector<std::string> stages = {"features",     "similarity", "clustering", "scoring",
+                                           "nms",          "initial_pose", "mls",      "icp",
+                                           "verification", "symmetries", "total"};
   ASSERT_EQ(r.stages.size(), stages.size());
   double sum = 0;
   for (std::size_t i = 0; i < stages.size(); ++i) {

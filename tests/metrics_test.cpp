@@ -1,5 +1,6 @@
 // Pose errors, matching and scores: ground truth scored against itself is perfect, each kind
 // of mistake costs exactly what the protocol says, and the BOP CSV reads back what was written.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -493,6 +494,27 @@ TEST(PrecisionRecall, OnePointPerScoreFromTheTopIgnoredLeftOut) {
   EXPECT_DOUBLE_EQ(all[0].scores.precision, 0.0);
   EXPECT_EQ(all.back().scores.fp, 3);
   EXPECT_TRUE(precisionRecallCurve({}, 3).empty());
+}
+
+TEST(PrecisionRecall, ThePlotShowsEachMethodsFiguresAtHalf) {
+  EvalReport report;
+  report.dataset = "stress";
+  report.split = "test";
+  MethodEvaluation m;
+  m.outcomes = {{1, 0.9f, true, false}, {1, 0.6f, true, false}, {1, 0.55f, false, false}, {1, 0.3f, false, false}};
+  m.summary.total.tp = 2;
+  m.summary.total.fn = 2;
+  report.methods.push_back(m);
+  m.method = EvalMethod::Linemod;
+  m.outcomes = {{1, 0.4f, true, false}};
+  report.methods.push_back(m);
+  const std::string svg = precisionRecallSvg(report);
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  // At 0.5: the three estimates from 0.55 up, two right, of four instances.
+  EXPECT_NE(svg.find("at 0.5: P 0.667 R 0.500"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("nothing scores 0.5"), std::string::npos);  // linemod's only estimate scores 0.4
+  EXPECT_EQ(std::count(svg.begin(), svg.end(), '\n') > 20, true);
 }
 
 }  // namespace

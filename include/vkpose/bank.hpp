@@ -82,6 +82,38 @@ struct UpAxisChoice {
 /// upside down (milk.stl: its cap at -z) is turned the right way up.
 UpAxisChoice findUpAxis(const Mesh& mesh);
 
+// ---- near-symmetries ------------------------------------------------------------------
+// Rotations that map the object's surface onto itself within a tolerance, found from the mesh
+// at training and stored in the bank. A pose and its symmetric alternatives fit the scene's
+// depth about equally well, so after ICP the detector renders each and lets appearance
+// (colour) decide (docs/pipeline.md, stages 0 and 8).
+
+/// One near-symmetry: a rotation about an axis through `point` (object frame, metres).
+struct NearSymmetry {
+  Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();  ///< unit
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();  ///< on the axis
+  float angle_deg = 0.f;
+  /// How far the turned surface lies from the surface: the 90th percentile of its samples'
+  /// distances to the nearest sample of the unturned surface, less the same figure for no turn
+  /// (the sampling's own spacing), metres.
+  float deviation_m = 0.f;
+
+  /// The turn as an object-frame transform: x -> R (x - point) + point. A pose P of the
+  /// object and P * transform() fit the same scene within deviation_m.
+  Pose transform() const;
+};
+
+/// The near-symmetries of a mesh: turns by 60, 90, 120, 180, 240, 270 and 300 degrees about
+/// each principal axis of its surface (through the surface's centroid) and about the model's
+/// x, y and z axes through its bounding box's centre, kept when the surface maps onto itself
+/// within `tolerance_m` (NearSymmetry::deviation_m). Sorted by deviation, at most `max_count`
+/// (a rotationally symmetric object passes every turn). Deterministic. An empty mesh or a
+/// tolerance <= 0 gives none.
+std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count = 7);
+
+/// "180 deg about (0.00, 0.00, 1.00)" for messages.
+std::string describe(const NearSymmetry& s);
+
 /// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`
 /// (in object coordinates) on the optical axis at `distance`.
 struct TrainingView {
@@ -154,6 +186,9 @@ struct TrainingParams {
   Camera camera;
   /// The object looks the same under some rotation (evaluation uses ADI instead of ADD).
   bool symmetric = false;
+  /// Near-symmetries (findNearSymmetries) are turns that map the surface onto itself within
+  /// this share of the diameter; the detector lets colour choose among them. 0: none looked for.
+  float near_symmetry_tolerance = 0.03f;
 };
 
 /// Throws InputError naming the bad value.
@@ -196,6 +231,9 @@ struct TemplateBank {
   Mesh mesh;
   TrainingParams params;
   std::vector<BankTemplate> templates;
+  /// Turns that map the mesh onto itself within params.near_symmetry_tolerance (version 4;
+  /// older banks find them from their mesh when loaded).
+  std::vector<NearSymmetry> near_symmetries;
 
   std::vector<LinemodTemplate> linemodTemplates() const;
 };
@@ -224,7 +262,7 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
 
 /// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
 /// FNV-1a 64 checksum of everything before it.
-constexpr uint32_t kBankVersion = 3;  // 2: the mesh is stored; 3: the up axis (2 reads as +z)
+constexpr uint32_t kBankVersion = 4;  // 2: the mesh is stored; 3: the up axis (2 reads as +z); 4: near-symmetries
 void saveBank(const TemplateBank& bank, const std::string& path);
 /// Throws InputError naming the file and the problem: missing, not a bank, another version,
 /// truncated, or a checksum mismatch.

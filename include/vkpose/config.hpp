@@ -92,8 +92,8 @@ struct RefineParams {
   /// MLS fits at most this many neighbours of a point (every k-th of a larger neighbourhood);
   /// 0: all of them, PCL's MovingLeastSquares exactly. A 1 cm neighbourhood at 0.7 m holds
   /// about 200 points; 64 still average the noise down 8-fold, fit a 6-coefficient quadric
-  /// with 10 points to spare per coefficient, and cost a third (IC-BIN: poses within 0.6 mm
-  /// of the full fit's, the same detections).
+  /// with 10 points to spare per coefficient, and cost a third (synthetic cup bin: poses within
+  /// 0.6 mm of the full fit's; IC-BIN: the same detections).
   int mls_max_neighbours = 64;
   /// Both clouds are voxel-filtered to this leaf size (metres), so that each surface patch
   /// weighs the same in the fit whatever the sensor's or the model's sampling. 0: no filter.
@@ -156,6 +156,13 @@ struct VerifyParams {
   /// claimed already by better detections is rejected (a small object laid onto a larger
   /// one's surface). 1: off.
   float max_shared_support = 0.5f;
+  /// Near-symmetries (TemplateBank::near_symmetries): an accepted pose and its turned
+  /// alternatives are rendered and compared with the scene's colour and depth
+  /// (appearanceAgreement); an alternative replaces ICP's pose, and is refined again, when it
+  /// scores at least `symmetry_margin` higher. A pose whose best rival comes within the margin
+  /// is flagged ambiguous_symmetry (always so for an uncoloured mesh).
+  bool resolve_symmetries = true;
+  float symmetry_margin = 0.05f;
 };
 /// Throws InputError naming the bad value.
 void validateVerifyParams(const VerifyParams& params);

@@ -24,6 +24,16 @@ class MeshRenderer;
 struct Hypothesis;
 struct ScoreScene;
 
+/// A pose that one of the object's near-symmetries offers (NearSymmetry), rendered and
+/// compared with the scene (VerifyParams::resolve_symmetries).
+struct SymmetryAlternative {
+  float angle_deg = 0.f;                            ///< 0: ICP's own pose
+  Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();  ///< object frame
+  float depth_fit = 0.f;  ///< share of the visible rendered pixels within tolerance of the scene's depth
+  float colour = 0.f;     ///< correlation of rendered and seen chromaticity, -1..1 (0 without colour)
+  float score = 0.f;      ///< depth_fit * (1 + colour) / 2 with colour, else depth_fit
+};
+
 /// One detected object instance.
 struct Detection {
   int bank = 0;
@@ -49,6 +59,13 @@ struct Detection {
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group
   std::string rejection;       ///< why a hypothesis was rejected (empty when accepted)
+  /// The near-symmetric poses compared (ICP's first; empty when the object has none or the
+  /// check did not run), the one kept, and by how much it beat the best other. Ambiguous:
+  /// the margin is below VerifyParams::symmetry_margin (an uncoloured mesh cannot tell).
+  std::vector<SymmetryAlternative> symmetry_alternatives;
+  int symmetry_chosen = 0;
+  float symmetry_margin = 0.f;
+  bool ambiguous_symmetry = false;
 };
 
 /// Milliseconds per stage, in pipeline order.
@@ -99,11 +116,13 @@ class Detector {
   std::unique_ptr<LinemodMatcher> matcher_;
   std::unique_ptr<ClusterScorer> scorer_;
   std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stage 6
+  std::vector<float> bounding_radius_;  ///< per bank: farthest mesh vertex from the bank's centre (stage 6's windows)
 
   const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running
 
   DetectionResult detectFrame(const LinemodFrame& frame, const Camera& camera, const LinemodFrame* next);
-  void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, DetectionResult& result);
+  void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, const cv::Mat& frame_bgr,
+                     DetectionResult& result);
 };
 
 // ---- detections to files --------------------------------------------------------------

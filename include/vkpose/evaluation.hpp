@@ -436,6 +436,9 @@ std::string evalReportJson(const EvalReport& report);
 /// The precision-recall curves of a report as CSV: `method,obj_id,threshold,precision,recall,f1,
 /// tp,fp,fn`, a curve per method for all objects together (obj_id 0) and per object.
 std::string precisionRecallCsv(const EvalReport& report);
+/// The same curves (all objects together, a colour per method) as an SVG plot: precision and
+/// recall against the score threshold, with each method's figures at score 0.5.
+std::string precisionRecallSvg(const EvalReport& report);
 
 /// The side-by-side table: a row per object and method, then each method's average.
 std::string evalReportTable(const EvalReport& report);

@@ -67,6 +67,11 @@ struct Pose {
   Eigen::Vector3f t = Eigen::Vector3f::Zero();
 };
 
+/// compose(a_T_b, b_T_c) = a_T_c: x maps to a.R (b.R x + b.t) + a.t.
+inline Pose compose(const Pose& a, const Pose& b) { return {a.R * b.R, a.R * b.t + a.t}; }
+/// invert(a_T_b) = b_T_a.
+inline Pose invert(const Pose& p) { return {p.R.transpose(), -(p.R.transpose() * p.t)}; }
+
 struct Camera {
   double fx = 572.4114, fy = 573.57043;  ///< focal lengths, pixels (default: the LINEMOD Kinect)
   double cx = 325.2611, cy = 242.04899;  ///< principal point, pixels

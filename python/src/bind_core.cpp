@@ -154,6 +154,22 @@ void bindCore(py::module_& m) {
           "templates", [](const TemplateBank& b) { return b.templates.size(); }, "Number of templates")
       .def_property_readonly("up_axis", &upAxis,
                              "The object's up axis the views were sampled about ('+z', '-z', ...), mesh frame")
+      .def_property_readonly(
+          "near_symmetries",
+          [](const TemplateBank& b) {
+            py::list out;
+            for (const auto& sym : b.near_symmetries) {
+              py::dict d;
+              d["angle_deg"] = tidy(sym.angle_deg);
+              d["axis"] = toArray(sym.axis);
+              d["point"] = toArray(sym.point);
+              d["deviation_m"] = tidy(sym.deviation_m);
+              out.append(d);
+            }
+            return out;
+          },
+          "Turns that map the mesh onto itself within the training tolerance: angle_deg about axis through point "
+          "(object frame, metres), deviation_m")
       .def_property_readonly("hemisphere", [](const TemplateBank& b) { return b.params.views.full_sphere ? "full" : "upper"; },
                              "'upper': views above the up axis; 'full': the whole sphere")
       .def_property_readonly("camera", [](const TemplateBank& b) { return b.params.camera; },

@@ -125,6 +125,26 @@ py::array_t<double> poseMatrix(const Pose& p) {
   return out;
 }
 
+/// The near-symmetric poses compared: {"alternatives": [{"angle_deg", "axis", "depth_fit",
+/// "colour", "score"}], "chosen": index, "margin": by how much it won}.
+py::dict symmetryDict(const Detection& d) {
+  py::list alternatives;
+  for (const auto& a : d.symmetry_alternatives) {
+    py::dict alt;
+    alt["angle_deg"] = tidy(a.angle_deg);
+    alt["axis"] = py::make_tuple(tidy(a.axis.x()), tidy(a.axis.y()), tidy(a.axis.z()));
+    alt["depth_fit"] = tidy(a.depth_fit);
+    alt["colour"] = tidy(a.colour);
+    alt["score"] = tidy(a.score);
+    alternatives.append(alt);
+  }
+  py::dict out;
+  out["alternatives"] = alternatives;
+  out["chosen"] = d.symmetry_chosen;
+  out["margin"] = tidy(d.symmetry_margin);
+  return out;
+}
+
 py::dict detectionDict(const Detection& d) {
   py::dict out;
   out["object"] = d.object;
@@ -148,6 +168,10 @@ py::dict detectionDict(const Detection& d) {
   out["icp_fitness"] = d.icp_fitness;
   out["icp_iterations"] = d.icp_iterations;
   out["rotation_votes"] = d.rotation_votes;
+  if (!d.symmetry_alternatives.empty()) {
+    out["symmetry"] = symmetryDict(d);
+    out["ambiguous_symmetry"] = d.ambiguous_symmetry;
+  }
   if (!d.rejection.empty()) out["reason"] = d.rejection;
   return out;
 }
@@ -330,6 +354,11 @@ leaves the config as it was.)")
                              "Mean squared ICP pair distance, m^2")
       .def_property_readonly("icp_iterations", [](const PyDetection& p) { return p.d.icp_iterations; })
       .def_property_readonly("rotation_votes", [](const PyDetection& p) { return p.d.rotation_votes; })
+      .def_property_readonly(
+          "symmetry", [](const PyDetection& p) { return p.d.symmetry_alternatives.empty() ? py::object(py::none()) : py::object(symmetryDict(p.d)); },
+          "The near-symmetric poses compared with the scene and the one kept (None when the object has none)")
+      .def_property_readonly("ambiguous_symmetry", [](const PyDetection& p) { return p.d.ambiguous_symmetry; },
+                             "Colour and depth could not tell the near-symmetric poses apart")
       .def_property_readonly("reason", [](const PyDetection& p) { return p.d.rejection; },
                              "Why it was rejected (rejected hypotheses only; empty otherwise)")
       .def("to_dict", [](const PyDetection& p) { return detectionDict(p.d); }, "Every field as a dict")

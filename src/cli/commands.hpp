@@ -41,6 +41,8 @@ void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what
 /// The stage parameters of a command: the config file's (when `path` is not empty), overridden
 /// by the flags that differ from the defaults.
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);
+/// The bank's near-symmetries, one line each (train and info --bank).
+void printNearSymmetries(const TemplateBank& bank);
 /// `vkpose bench train`, registered under the `bench` subcommand; the runner runs it.
 Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 /// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.

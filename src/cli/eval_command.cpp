@@ -63,8 +63,8 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
                   "r/vkpose_lmo-test.csv, ...)");
   sub->add_option("--report", opt->report, "JSON report to write (per method: average and per-object scores)");
   sub->add_option("--pr-curve", opt->pr_curve,
-                  "Precision-recall curves CSV to write (per method, all objects and each object: precision, recall "
-                  "and F1 of the estimates scoring at least each threshold)");
+                  "Precision-recall curves to write (per method, all objects and each object: precision, recall "
+                  "and F1 of the estimates scoring at least each threshold): CSV, or an SVG plot when FILE ends in .svg");
   sub->add_option("--images", p.max_images, "Evaluate the first N images only (0: all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -151,7 +151,8 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       if (!global.quiet) fmt::print("wrote {}\n", opt->report);
     }
     if (!opt->pr_curve.empty()) {
-      writeTextFile(opt->pr_curve, precisionRecallCsv(report), opt->force);
+      const bool svg = std::filesystem::path(opt->pr_curve).extension() == ".svg";
+      writeTextFile(opt->pr_curve, svg ? precisionRecallSvg(report) : precisionRecallCsv(report), opt->force);
       for (const MethodEvaluation& m : report.methods) {
         const auto curve = precisionRecallCurve(m.outcomes, m.summary.total.tp + m.summary.total.fn);
         const PrPoint* at_half = nullptr;

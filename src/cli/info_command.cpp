@@ -8,6 +8,19 @@
 
 namespace vkpose::cli {
 
+void printNearSymmetries(const TemplateBank& bank) {
+  if (bank.near_symmetries.empty()) {
+    fmt::print("near-symmetries: none within {:.1f}% of the diameter\n", 100.f * bank.params.near_symmetry_tolerance);
+    return;
+  }
+  fmt::print("near-symmetries: {} within {:.1f}% of the diameter ({})\n", bank.near_symmetries.size(),
+             100.f * bank.params.near_symmetry_tolerance,
+             bank.mesh.colours.empty()
+                 ? "the mesh has no colours: detection reports such poses ambiguous unless depth tells them apart"
+                 : "detection lets the mesh's colours choose among them");
+  for (const auto& s : bank.near_symmetries) fmt::print("  {}\n", describe(s));
+}
+
 namespace {
 void printBankSummary(const TemplateBank& bank, const std::string& path) {
   const auto& p = bank.params;
@@ -29,6 +42,7 @@ void printBankSummary(const TemplateBank& bank, const std::string& path) {
              p.features.use_depth ? "depth" : "",
              bank.templates.empty() ? 0.0 : static_cast<double>(features) / static_cast<double>(bank.templates.size()));
   fmt::print("camera: fx {:.2f} fy {:.2f}\n", p.camera.fx, p.camera.fy);
+  printNearSymmetries(bank);
 }
 }  // namespace
 

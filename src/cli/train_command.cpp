@@ -19,7 +19,7 @@ struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
       up = "auto";
   int views = 216, features = 63;
-  float max_view_angle = 180.f;
+  float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
   bool symmetric = false, force = false;
 };
 
@@ -33,6 +33,7 @@ TrainingParams trainingParamsFrom(const TrainOptions& o) {
   p.views.full_sphere = o.hemisphere == "full";
   p.features_per_modality = o.features;
   p.symmetric = o.symmetric;
+  p.near_symmetry_tolerance = o.near_symmetry_tolerance;
   if (!o.camera.empty()) p.camera = loadCamera(o.camera);
   if (o.up != "auto") p.views.up = parseUpAxis(o.up);
   validateTrainingParams(p);
@@ -71,6 +72,11 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--camera", opt->camera, "BOP camera.json of the sensor (focal lengths); default: LINEMOD's Kinect");
   sub->add_flag("--symmetric", opt->symmetric, "The object is symmetric (evaluation scores it with ADI)");
+  sub->add_option("--near-symmetry-tolerance", opt->near_symmetry_tolerance,
+                  "Turns that map the surface onto itself within this share of the diameter are near-symmetries: "
+                  "detection lets the mesh's colours choose among them (0: none)")
+      ->check(CLI::Range(0.0, 0.2))
+      ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out if it exists");
   return [opt, &global]() {
     TrainingParams params = trainingParamsFrom(*opt);
@@ -111,6 +117,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
     saveBank(bank, opt->out);
     const auto bytes = std::filesystem::file_size(opt->out);
     fmt::print("templates: {}\n", bank.templates.size());
+    printNearSymmetries(bank);
     if (!global.quiet) {
       if (timings.dropped) fmt::print("dropped: {} views with too few features\n", timings.dropped);
       fmt::print("time: {:.1f} s (render {:.1f} s, features {:.1f} s) on {}, {:.0f} templates/s\n",

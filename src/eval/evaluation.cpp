@@ -211,6 +211,61 @@ std::string precisionRecallCsv(const EvalReport& report) {
   return out;
 }
 
+std::string precisionRecallSvg(const EvalReport& report) {
+  // Precision and recall (y) of the estimates scoring at least each threshold (x), all objects
+  // together, one colour per method; the line at 0.5 is where the README reads them.
+  constexpr double W = 720, H = 440, left = 60, right = 200, top = 40, bottom = 50;
+  const auto px = [&](double score) { return left + std::clamp(score, 0.0, 1.0) * (W - left - right); };
+  const auto py = [&](double v) { return H - bottom - std::clamp(v, 0.0, 1.0) * (H - top - bottom); };
+  static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  std::string out = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" font-family=\"sans-serif\" "
+      "font-size=\"12\">\n<rect width=\"{0}\" height=\"{1}\" fill=\"white\"/>\n"
+      "<text x=\"{2}\" y=\"22\" font-size=\"14\">{3} ({4}): precision (solid) and recall (dashed) of the "
+      "estimates scoring at least x</text>\n",
+      W, H, left, report.dataset, report.split);
+  for (int i = 0; i <= 10; ++i) {
+    const double v = i / 10.0;
+    out += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"#ddd\"/>"
+                       "<text x=\"{3}\" y=\"{4}\" text-anchor=\"end\">{5:.1f}</text>\n",
+                       px(0), py(v), px(1), left - 6, py(v) + 4, v);
+    out += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#ddd\"/>"
+                       "<text x=\"{0}\" y=\"{3}\" text-anchor=\"middle\">{4:.1f}</text>\n",
+                       px(v), py(0), py(1), py(0) + 16, v);
+  }
+  out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">score threshold</text>\n", px(0.5), H - 10);
+  out += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"black\" "
+                     "stroke-dasharray=\"2,3\"/>\n",
+                     px(0.5), py(0), py(1));
+  for (std::size_t m = 0; m < report.methods.size(); ++m) {
+    const MethodEvaluation& method = report.methods[m];
+    const char* colour = colours[m % std::size(colours)];
+    const auto curve = precisionRecallCurve(method.outcomes, method.summary.total.tp + method.summary.total.fn);
+    std::string precision, recall;
+    const PrPoint* at_half = nullptr;
+    for (const PrPoint& p : curve) {
+      precision += fmt::format("{:.1f},{:.1f} ", px(p.threshold), py(p.scores.precision));
+      recall += fmt::format("{:.1f},{:.1f} ", px(p.threshold), py(p.scores.recall));
+      if (p.threshold >= 0.5f) at_half = &p;
+    }
+    out += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\"/>\n", colour, precision);
+    out += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" stroke-dasharray=\"6,4\" "
+                       "points=\"{}\"/>\n",
+                       colour, recall);
+    const double y = top + 20 + 50.0 * static_cast<double>(m);
+    out += fmt::format("<text x=\"{}\" y=\"{}\" fill=\"{}\" font-weight=\"bold\">{}</text>\n", W - right + 12, y,
+                       colour, methodName(method.method));
+    out += fmt::format("<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text>\n", W - right + 12, y + 16, colour,
+                       at_half ? fmt::format("at 0.5: P {:.3f} R {:.3f}", at_half->scores.precision,
+                                             at_half->scores.recall)
+                               : std::string("nothing scores 0.5"));
+    if (at_half)
+      out += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/>\n", px(0.5), py(at_half->scores.precision),
+                         colour);
+  }
+  return out + "</svg>\n";
+}
+
 std::string evalReportJson(const EvalReport& report) {
   using nlohmann::json;
   json methods = json::object();

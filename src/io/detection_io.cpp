@@ -67,6 +67,20 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
   j["centre"] = {round(d.x, 1), round(d.y, 1)};
   j["template"] = d.template_index;
   j["similarity"] = round(d.similarity, 2);
+  if (!d.symmetry_alternatives.empty()) {
+    // Which near-symmetric poses were compared and by how much the kept one won.
+    auto alternatives = nlohmann::ordered_json::array();
+    for (const auto& a : d.symmetry_alternatives)
+      alternatives.push_back({{"angle_deg", round(a.angle_deg, 1)},
+                              {"axis", {round(a.axis.x(), 4), round(a.axis.y(), 4), round(a.axis.z(), 4)}},
+                              {"depth_fit", round(a.depth_fit, 4)},
+                              {"colour", round(a.colour, 4)},
+                              {"score", round(a.score, 4)}});
+    j["symmetry"] = {{"alternatives", std::move(alternatives)},
+                     {"chosen", d.symmetry_chosen},
+                     {"margin", round(d.symmetry_margin, 4)}};
+    j["ambiguous_symmetry"] = d.ambiguous_symmetry;
+  }
   if (!d.rejection.empty()) j["reason"] = d.rejection;
   return j;
 }

@@ -10,6 +10,7 @@
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pose/appearance.hpp"
 #include "pose/initial_pose.hpp"
 #include "pose/point_cloud.hpp"
 #include "pose/refine.hpp"
@@ -87,6 +88,10 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
   matcher_->setTemplates(concatenateTemplates(banks_), match::templateDepthGates(banks_));
   scorer_ = std::make_unique<ClusterScorer>(ctx_);
+  bounding_radius_.assign(banks_.size(), 0.f);
+  for (std::size_t b = 0; b < banks_.size(); ++b)
+    for (const auto& v : banks_[b].mesh.vertices)
+      bounding_radius_[b] = std::max(bounding_radius_[b], (v - banks_[b].centre).norm());
 }
 
 Detector::~Detector() = default;
@@ -205,7 +210,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   }
 
   if (params_.estimate_poses) {
-    estimatePoses(hypotheses, scene, result);
+    estimatePoses(hypotheses, scene, frame.bgr, result);
   } else {
     for (const auto& h : hypotheses) {
       Detection d = hypothesisDetection(h, banks_);
@@ -220,7 +225,11 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
 }
 
 void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene,
-                             DetectionResult& result) {
+                             const cv::Mat& frame_bgr, DetectionResult& result) {
+  // Colour for the near-symmetries' check; a frame without it (depth only) compares depth.
+  const cv::Mat scene_bgr = frame_bgr.type() == CV_8UC3 && frame_bgr.size() == scene.depth_m.size()
+                                ? frame_bgr
+                                : cv::Mat(scene.depth_m.size(), CV_8UC3, cv::Scalar::all(0));
   const Camera& camera = scene.camera;
   const std::size_t n = hypotheses.size();
   // Stage 6: rotations, then one render call per bank, then the translations in parallel.
@@ -244,15 +253,11 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
   // Each candidate renders in its own window (projectedWindow: the box of the object's
   // bounding sphere), one small submit each: a full-frame rendering per candidate cost more
   // than the rest of stage 6.
-  std::vector<float> bounding_radius(banks_.size(), 0.f);
-  for (std::size_t b = 0; b < banks_.size(); ++b)
-    for (const auto& v : banks_[b].mesh.vertices)
-      bounding_radius[b] = std::max(bounding_radius[b], (v - banks_[b].centre).norm());
   std::vector<Rendering> renderings(n);
   std::vector<cv::Rect> windows(n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
-    windows[i] = projectedWindow(rendered[i], banks_[b].centre, bounding_radius[b], camera);
+    windows[i] = projectedWindow(rendered[i], banks_[b].centre, bounding_radius_[b], camera);
     if (windows[i].empty()) continue;  // initialTranslation says why
     renderings[i] = std::move(renderers_[b]->render(windowCamera(camera, windows[i]), {rendered[i]}).front());
   }
@@ -322,20 +327,74 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
   std::vector<DepthAgreement> agreement(n);
   std::vector<float> support(n, 0.f);
   std::vector<std::vector<int>> explained(n);  // scene cells each pose explains, for the competition below
+  const auto verifyCandidate = [&](std::size_t i) {
+    const auto start = std::chrono::steady_clock::now();
+    const PointCloud model = transformed(initial[i].model_points, refined[i].pose);
+    const VerifyParams& vp = verify_params[i];
+    verified[i] = verifyPose(model, initial[i].scene_points, vp);
+    agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
+    support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
+    explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
+    cpu_ms[i] += msSince(start);
+  };
   util::parallelFor(
       n,
       [&](std::size_t i) {
-        if (!initial[i].ok) return;
-        const auto start = std::chrono::steady_clock::now();
-        const PointCloud model = transformed(initial[i].model_points, refined[i].pose);
-        const VerifyParams& vp = verify_params[i];
-        verified[i] = verifyPose(model, initial[i].scene_points, vp);
-        agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
-        support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
-        explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
-        cpu_ms[i] += msSince(start);
+        if (initial[i].ok) verifyCandidate(i);
       },
       params_.threads);
+
+  // Near-symmetries: each pose that passed the collision test and its turned alternatives
+  // render in one window (GPU, one submit per candidate) and are compared with the scene's
+  // colour and depth; a clear winner other than ICP's pose is refined from there and
+  // verified again.
+  const auto symmetries0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto b = static_cast<std::size_t>(hypotheses[i].bank);
+    const auto& symmetries = banks_[b].near_symmetries;
+    if (!initial[i].ok || !verified[i].accepted || symmetries.empty() || !params_.verify.resolve_symmetries) continue;
+    std::vector<Pose> poses{refined[i].pose};
+    for (const auto& s : symmetries) poses.push_back(compose(refined[i].pose, s.transform()));
+    cv::Rect window;
+    for (const auto& p : poses) window |= projectedWindow(p, banks_[b].centre, bounding_radius_[b], camera);
+    if (window.empty()) continue;
+    const auto views = renderers_[b]->render(windowCamera(camera, window), poses);
+    Detection& d = dets[i];
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const AppearanceAgreement a =
+          appearanceAgreement(views[k], window, scene_bgr, scene.depth_m, verify_params[i].see_through_tolerance);
+      SymmetryAlternative alt;
+      if (k > 0) alt.angle_deg = symmetries[k - 1].angle_deg, alt.axis = symmetries[k - 1].axis;
+      alt.depth_fit = a.depth_fit;
+      alt.colour = a.colour;
+      alt.score = a.score;
+      d.symmetry_alternatives.push_back(alt);
+    }
+    const auto& alts = d.symmetry_alternatives;
+    const auto best = static_cast<std::size_t>(
+        std::max_element(alts.begin(), alts.end(), [](const auto& x, const auto& y) { return x.score < y.score; }) -
+        alts.begin());
+    float rival = -1.f;
+    for (std::size_t k = 0; k < alts.size(); ++k)
+      if (k != best) rival = std::max(rival, alts[k].score);
+    const float margin = params_.verify.symmetry_margin;
+    // ICP's pose stays unless an alternative beats it by the margin.
+    const std::size_t chosen = best != 0 && alts[best].score >= alts[0].score + margin ? best : 0;
+    d.symmetry_chosen = static_cast<int>(chosen);
+    d.symmetry_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
+    d.ambiguous_symmetry = d.symmetry_margin < margin;
+    if (chosen == 0) continue;
+    // The turned pose shows other faces of the model: ICP and verification take those.
+    initial[i].model_points = visibleModelPoints(views[chosen], poses[chosen], camera, window);
+    RefineParams icp_params = refine_params[i];
+    icp_params.mls = false;
+    icp_params.coarse_iterations = 0;  // a turn of the surface onto itself: only the fine fit is left
+    const auto start = std::chrono::steady_clock::now();
+    refined[i] = refinePose(initial[i].model_points, smoothed[i], poses[chosen], icp_params);
+    cpu_ms[i] += msSince(start);
+    verifyCandidate(i);
+  }
+  const double symmetries_ms = msSince(symmetries0);
   for (std::size_t i = 0; i < n; ++i)
     if (initial[i].ok) ++result.refined_candidates, result.refine_cpu_ms += cpu_ms[i];
 
@@ -425,7 +484,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     for (const int cell : cells) claimed.emplace(cell, result.detections.size());
     result.detections.push_back(std::move(d));
   }
-  result.timings_ms.emplace_back("verification", msSince(t0));
+  result.timings_ms.emplace_back("verification", msSince(t0) - symmetries_ms);
+  result.timings_ms.emplace_back("symmetries", symmetries_ms);
 }
 
 }  // namespace vkpose

@@ -83,6 +83,8 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the silhouette support must be in [0, 1], got {}", params.min_silhouette_support));
   if (!(params.max_shared_support >= 0.f && params.max_shared_support <= 1.f))
     throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
+  if (!(params.symmetry_margin >= 0.f && params.symmetry_margin <= 1.f))
+    throw InputError(fmt::format("the symmetry margin must be in [0, 1], got {}", params.symmetry_margin));
 }
 
 void validateSensorParams(const SensorParams& p) {

@@ -140,6 +140,23 @@ Camera windowCamera(const Camera& camera, const cv::Rect& window) {
   return w;
 }
 
+PointCloud visibleModelPoints(const Rendering& rendering, const Pose& pose, const Camera& camera,
+                              const cv::Rect& window) {
+  PointCloud out;
+  const Eigen::Matrix3f R_inv = pose.R.transpose();
+  for (int v = window.y; v < window.y + window.height; ++v) {
+    const float* zr = rendering.depth.ptr<float>(v - window.y);
+    for (int u = window.x; u < window.x + window.width; ++u) {
+      const float z = zr[u - window.x];
+      if (!(z > 0.f)) continue;
+      const Eigen::Vector3f pm(static_cast<float>((u - camera.cx) / camera.fx) * z,
+                               static_cast<float>((v - camera.cy) / camera.fy) * z, z);
+      out.push_back(R_inv * (pm - pose.t));
+    }
+  }
+  return out;
+}
+
 InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered, const cv::Mat& scene_depth_m,
                                const Camera& camera, float diameter, const InitialPoseParams& params,
                                const cv::Rect& window_in) {
@@ -161,7 +178,7 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
   std::size_t model_count = 0;
   cv::Rect box;  // the rendered object's pixels
   float z_min = std::numeric_limits<float>::max(), z_max = 0.f;
-  const Eigen::Matrix3f R_inv = rendered.R.transpose();
+  out.model_points = visibleModelPoints(rendering, rendered, camera, window);
   for (int v = window.y; v < window.y + window.height; ++v) {
     const float* zr = rendering.depth.ptr<float>(v - window.y);
     const float* zs = scene_depth_m.ptr<float>(v);
@@ -173,7 +190,6 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
       z_min = std::min(z_min, z);
       z_max = std::max(z_max, z);
       const Eigen::Vector3f pm = backProject(u, v, z);
-      out.model_points.push_back(R_inv * (pm - rendered.t));
       if (!(zs[u] > 0.f) || zs[u] < z - band) continue;  // no depth, or an occluder
       model_sum += pm.cast<double>();
       ++model_count;

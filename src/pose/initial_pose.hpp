@@ -66,6 +66,11 @@ Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const 
 /// member's measured depth offset: where stage 6 renders the model.
 Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const TemplateBank& bank, const Camera& camera);
 
+/// The model surface a rendering of `pose` shows, object frame (metres), row by row: the
+/// rendering covers `window` of `camera`'s image (windowCamera).
+PointCloud visibleModelPoints(const Rendering& rendering, const Pose& pose, const Camera& camera,
+                              const cv::Rect& window);
+
 struct InitialPose {
   Pose pose;  ///< the rendered pose moved by the centroid difference
   /// The model surface the camera sees at the rendered pose, object frame (metres): what ICP

@@ -98,19 +98,7 @@ std::optional<Pose> tryInBin(const Mesh& mesh, const std::vector<RestingOrientat
 
 }  // namespace
 
-Pose compose(const Pose& a, const Pose& b) {
-  Pose out;
-  out.R = a.R * b.R;
-  out.t = a.R * b.t + a.t;
-  return out;
-}
 
-Pose invert(const Pose& p) {
-  Pose out;
-  out.R = p.R.transpose();
-  out.t = -(out.R * p.t);
-  return out;
-}
 
 OrientedBox orientedBox(const Mesh& mesh, const Pose& world_T_object) {
   OrientedBox b;

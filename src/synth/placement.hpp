@@ -22,10 +22,6 @@ inline float uniform(std::mt19937& rng, float lo, float hi) {
   return lo + (hi - lo) * static_cast<float>(rng() >> 8) * (1.f / 16777216.f);
 }
 
-/// compose(a_T_b, b_T_c) = a_T_c: x maps to a.R (b.R x + b.t) + a.t.
-Pose compose(const Pose& a, const Pose& b);
-/// invert(a_T_b) = b_T_a.
-Pose invert(const Pose& p);
 
 /// An oriented box, world frame: centre, axes (columns, unit) and half side lengths, metres.
 struct OrientedBox {

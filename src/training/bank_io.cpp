@@ -159,6 +159,7 @@ void writeParams(Writer& w, const TrainingParams& p) {
   w.put(static_cast<int32_t>(p.camera.width));
   w.put(static_cast<int32_t>(p.camera.height));
   for (int i = 0; i < 3; ++i) w.put(p.views.up[i]);  // version 3
+  w.put(p.near_symmetry_tolerance);                   // version 4
 }
 
 void writePayload(Writer& w, const TemplateBank& bank) {
@@ -198,6 +199,13 @@ void writePayload(Writer& w, const TemplateBank& bank) {
     w.putArray(t.crop.depth_01mm);
     w.putArray(t.crop.normals);
   }
+  w.put(static_cast<uint32_t>(bank.near_symmetries.size()));  // version 4
+  for (const auto& s : bank.near_symmetries) {
+    for (int i = 0; i < 3; ++i) w.put(s.axis[i]);
+    for (int i = 0; i < 3; ++i) w.put(s.point[i]);
+    w.put(s.angle_deg);
+    w.put(s.deviation_m);
+  }
 }
 
 TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
@@ -236,6 +244,7 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
     for (int i = 0; i < 3; ++i) p.views.up[i] = r.get<float>();
     if (!p.views.up.allFinite() || std::abs(p.views.up.norm() - 1.f) > 1e-3f) r.fail("up axis is not a unit vector");
   }  // version 2 banks were all trained about +z
+  if (version >= 4) p.near_symmetry_tolerance = r.get<float>();
   try {
     validateTrainingParams(p);
   } catch (const InputError& e) {
@@ -281,6 +290,24 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
     t.crop.depth_01mm = r.getArray<uint16_t>(cells);
     t.crop.normals = r.getArray<int8_t>(cells * 3);
     bank.templates.push_back(std::move(t));
+  }
+  if (version >= 4) {
+    const auto symmetries = r.get<uint32_t>();
+    if (symmetries > 64) r.fail(fmt::format("{} near-symmetries", symmetries));
+    for (uint32_t i = 0; i < symmetries; ++i) {
+      NearSymmetry s;
+      for (int k = 0; k < 3; ++k) s.axis[k] = r.get<float>();
+      for (int k = 0; k < 3; ++k) s.point[k] = r.get<float>();
+      s.angle_deg = r.get<float>();
+      s.deviation_m = r.get<float>();
+      if (!s.axis.allFinite() || std::abs(s.axis.norm() - 1.f) > 1e-3f || !s.point.allFinite() ||
+          !std::isfinite(s.angle_deg) || !std::isfinite(s.deviation_m))
+        r.fail(fmt::format("near-symmetry {} is not a turn about a unit axis", i));
+      bank.near_symmetries.push_back(s);
+    }
+  } else {
+    // Older banks: the turns their mesh has, as training would find them now.
+    bank.near_symmetries = findNearSymmetries(bank.mesh, p.near_symmetry_tolerance * bank.diameter);
   }
   if (!r.done()) r.fail("bytes left after the last template");
   try {
@@ -335,8 +362,8 @@ TemplateBank loadBank(const std::string& path) {
   }
   uint32_t version;
   std::memcpy(&version, bytes.data() + 8, 4);
-  if (version != kBankVersion && version != 2)
-    throw InputError(fmt::format("{}: template bank version {}, this vkpose reads versions 2 and {}: train it again",
+  if (version > kBankVersion || version < 2)
+    throw InputError(fmt::format("{}: template bank version {}, this vkpose reads versions 2 to {}: train it again",
                                  path, version, kBankVersion));
   uint64_t payload_bytes;
   std::memcpy(&payload_bytes, bytes.data() + 16, 8);

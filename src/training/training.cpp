@@ -354,6 +354,7 @@ TemplateBank trainTemplatesWith(const GpuContext& ctx, const Mesh& mesh, const T
   bank.centre = mesh.bboxCentre();
   bank.mesh = mesh;
   bank.params = params;
+  bank.near_symmetries = findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter);
   const Camera tile = trainingCamera(mesh, params, views);
   // Views differing only by in-plane rotation share one rendering: the GPU renders each
   // (viewpoint, distance) once and the rotations are image rotations of it (exact for a

@@ -14,6 +14,9 @@ void validateTrainingParams(const TrainingParams& p) {
   validateCamera(p.camera, "training camera");
   if (p.features_per_modality < 4 || p.features_per_modality > 4096)
     throw InputError(fmt::format("features: {} per modality; use 4 to 4096", p.features_per_modality));
+  if (!(p.near_symmetry_tolerance >= 0.f && p.near_symmetry_tolerance <= 0.2f))
+    throw InputError(fmt::format("near-symmetry tolerance {} must be in [0, 0.2] (a share of the diameter)",
+                                 p.near_symmetry_tolerance));
   if (!(p.strong_threshold > 0.f && p.strong_threshold < 2000.f))
     throw InputError(fmt::format("strong threshold {} must be in (0, 2000)", p.strong_threshold));
 }

@@ -1,0 +1,160 @@
+// Near-symmetries from the mesh (include/vkpose/bank.hpp, near-symmetries): the surface, sampled evenly by
+// area, is turned about candidate axes and compared with a second, independent sampling of
+// itself. Two samplings of the same surface are a spacing apart even without a turn, so that
+// spacing (measured with no turn) is taken off.
+#include "vkpose/bank.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "pose/nearest_neighbours.hpp"
+
+namespace vkpose {
+
+namespace {
+
+constexpr int kSamples = 12000;
+/// The share of the turned surface that must lie within the tolerance: the rest may stick
+/// out (a spout, a seam, a small handle: what only appearance or a close look tells apart).
+constexpr float kQuantile = 0.9f;
+constexpr std::array<float, 7> kAngles{60.f, 90.f, 120.f, 180.f, 240.f, 270.f, 300.f};
+
+/// Points spread over the surface by area (a fixed seed: training is deterministic).
+PointCloud sampleSurface(const Mesh& mesh, int count, unsigned seed) {
+  std::vector<double> cumulative;
+  cumulative.reserve(mesh.faces.size());
+  double total = 0;
+  for (const auto& f : mesh.faces) {
+    total += 0.5 * (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]).norm();
+    cumulative.push_back(total);
+  }
+  PointCloud out;
+  if (total <= 0) return out;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> area(0.0, total);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  out.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const auto k = static_cast<std::size_t>(std::lower_bound(cumulative.begin(), cumulative.end(), area(rng)) -
+                                            cumulative.begin());
+    const auto& f = mesh.faces[std::min(k, mesh.faces.size() - 1)];
+    float u = unit(rng), v = unit(rng);
+    if (u + v > 1.f) u = 1.f - u, v = 1.f - v;
+    out.push_back(mesh.vertices[f[0]] + u * (mesh.vertices[f[1]] - mesh.vertices[f[0]]) +
+                  v * (mesh.vertices[f[2]] - mesh.vertices[f[0]]));
+  }
+  return out;
+}
+
+/// The samples' distances to the surface, capped: a search within `cap` of each point (a turn
+/// whose points lie farther is no symmetry whatever the exact figure).
+class CappedDistance {
+ public:
+  CappedDistance(const PointCloud& surface, float cap) : surface_(surface), index_(surface, 0.5f * cap), cap_(cap) {}
+
+  /// The `share` quantile of the distances from `points`, turned, to the surface; cap_ when
+  /// at least that share lies farther. Checks a first slice of the points and gives up early
+  /// when it already misses `give_up` (most turns are far from symmetric).
+  float quantile(const PointCloud& points, const Pose& turn, float share, float give_up) {
+    std::vector<float> d;
+    d.reserve(points.size());
+    const std::size_t slice = std::min<std::size_t>(points.size(), 1500);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (i == slice && quantileOf(d, share) > give_up) return cap_;
+      d.push_back(nearest(turn.R * points[i] + turn.t));
+    }
+    return quantileOf(d, share);
+  }
+
+ private:
+  float nearest(const Eigen::Vector3f& q) {
+    found_.clear();
+    index_.within(q, cap_, found_);
+    float best = cap_ * cap_;
+    for (const int k : found_) best = std::min(best, (surface_[static_cast<std::size_t>(k)] - q).squaredNorm());
+    return std::sqrt(best);
+  }
+  static float quantileOf(std::vector<float> d, float share) {
+    if (d.empty()) return 0.f;
+    const auto k = d.begin() + static_cast<std::ptrdiff_t>(share * static_cast<float>(d.size() - 1));
+    std::nth_element(d.begin(), k, d.end());
+    return *k;
+  }
+  PointCloud surface_;
+  NearestNeighbours index_;
+  float cap_;
+  std::vector<int> found_;
+};
+
+}  // namespace
+
+Pose NearSymmetry::transform() const {
+  Pose p;
+  p.R = Eigen::AngleAxisf(angle_deg * static_cast<float>(M_PI) / 180.f, axis.normalized()).toRotationMatrix();
+  p.t = point - p.R * point;
+  return p;
+}
+
+std::string describe(const NearSymmetry& s) {
+  return fmt::format("{:.0f} deg about ({:.2f}, {:.2f}, {:.2f}) through ({:.1f}, {:.1f}, {:.1f}) mm, off by {:.1f} mm",
+                     s.angle_deg, s.axis.x(), s.axis.y(), s.axis.z(), 1e3f * s.point.x(), 1e3f * s.point.y(),
+                     1e3f * s.point.z(), 1e3f * s.deviation_m);
+}
+
+std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count) {
+  std::vector<NearSymmetry> found;
+  if (tolerance_m <= 0.f || mesh.faces.empty() || max_count <= 0) return found;
+  const PointCloud a = sampleSurface(mesh, kSamples, 1u), b = sampleSurface(mesh, kSamples, 2u);
+  if (a.empty()) return found;
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  for (const auto& p : a) mean += p;
+  mean /= static_cast<float>(a.size());
+  Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+  for (const auto& p : a) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> eig(cov);
+
+  // Axes: the principal axes through the surface's centroid, then the model's axes through
+  // the box centre (a carton with a spout has its centroid off the prism's axis).
+  std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> axes;  // direction, point
+  for (int i = 2; i >= 0; --i) axes.emplace_back(eig.eigenvectors().col(i).normalized(), mean);
+  for (int i = 0; i < 3; ++i) axes.emplace_back(Eigen::Vector3f::Unit(i), mesh.bboxCentre());
+
+  // Distances are searched up to the tolerance plus a few sampling spacings (the floor).
+  const float spacing = mesh.diameter / std::sqrt(static_cast<float>(kSamples));
+  CappedDistance distance(b, tolerance_m + 4.f * spacing);
+  const float floor = distance.quantile(a, Pose{}, kQuantile, 1e9f);
+
+  for (const auto& [axis, point] : axes) {
+    for (const float angle : kAngles) {
+      NearSymmetry s;
+      s.axis = axis;
+      s.point = point;
+      s.angle_deg = angle;
+      s.deviation_m = std::max(0.f, distance.quantile(a, s.transform(), kQuantile, tolerance_m + floor) - floor);
+      if (s.deviation_m > tolerance_m) continue;
+      // The same turn found twice (a principal axis near a model axis): keep the closer fit.
+      const Pose t = s.transform();
+      const Eigen::Vector3f c = mesh.bboxCentre();
+      const auto same = std::find_if(found.begin(), found.end(), [&](const NearSymmetry& o) {
+        const Pose u = o.transform();
+        return (t.R - u.R).norm() < 0.25f && ((t.R * c + t.t) - (u.R * c + u.t)).norm() < tolerance_m;
+      });
+      if (same == found.end())
+        found.push_back(s);
+      else if (s.deviation_m < same->deviation_m)
+        *same = s;
+    }
+  }
+  std::stable_sort(found.begin(), found.end(),
+                   [](const NearSymmetry& x, const NearSymmetry& y) { return x.deviation_m < y.deviation_m; });
+  if (found.size() > static_cast<std::size_t>(max_count)) found.resize(static_cast<std::size_t>(max_count));
+  return found;
+}
+
+}  // namespace vkpose
