@@ -55,6 +55,10 @@ struct Detection {
   float see_through = 0.f;     ///< share of the visible model points the camera sees through
   float depth_fit = 0.f;       ///< share of the visible model points within tolerance of the scene depth
   float silhouette_support = 0.f;  ///< share of the outline with a depth step behind it
+  /// Correlation (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
+  /// where the pose fits the depth (appearanceAgreement); 1 when not measured (a mesh without
+  /// colours, or of one colour).
+  float colour_agreement = 1.f;
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group

@@ -344,22 +344,27 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       },
       params_.threads);
 
-  // Near-symmetries: each pose that passed the collision test and its turned alternatives
-  // render in one window (GPU, one submit per candidate) and are compared with the scene's
-  // colour and depth; a clear winner other than ICP's pose is refined from there and
-  // verified again.
+  // Render and compare: each pose that passed the collision test and its near-symmetric
+  // alternatives render in one window (GPU, one submit per candidate) and are compared with
+  // the scene's colour and depth. A clear winner other than ICP's pose is refined from there
+  // and verified again; the kept pose's colour agreement is a test of its own (look-alikes of
+  // the right shape and the wrong colours). Meshes without colour and symmetry skip it.
   const auto symmetries0 = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < n; ++i) {
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
+    const bool turns = params_.verify.resolve_symmetries && !banks_[b].near_symmetries.empty();
+    const bool colours = !banks_[b].mesh.colours.empty() && params_.verify.min_colour_agreement > -1.f;
+    if (!initial[i].ok || !verified[i].accepted || !(turns || colours)) continue;
     const auto& symmetries = banks_[b].near_symmetries;
-    if (!initial[i].ok || !verified[i].accepted || symmetries.empty() || !params_.verify.resolve_symmetries) continue;
     std::vector<Pose> poses{refined[i].pose};
-    for (const auto& s : symmetries) poses.push_back(compose(refined[i].pose, s.transform()));
+    if (turns)
+      for (const auto& s : symmetries) poses.push_back(compose(refined[i].pose, s.transform()));
     cv::Rect window;
     for (const auto& p : poses) window |= projectedWindow(p, banks_[b].centre, bounding_radius_[b], camera);
     if (window.empty()) continue;
     const auto views = renderers_[b]->render(windowCamera(camera, window), poses);
-    Detection& d = dets[i];
+    std::vector<SymmetryAlternative> alts;
+    bool informative = false;
     for (std::size_t k = 0; k < poses.size(); ++k) {
       const AppearanceAgreement a =
           appearanceAgreement(views[k], window, scene_bgr, scene.depth_m, verify_params[i].see_through_tolerance);
@@ -368,9 +373,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       alt.depth_fit = a.depth_fit;
       alt.colour = a.colour;
       alt.score = a.score;
-      d.symmetry_alternatives.push_back(alt);
+      alts.push_back(alt);
+      informative = informative || a.colour_informative;
     }
-    const auto& alts = d.symmetry_alternatives;
     const auto best = static_cast<std::size_t>(
         std::max_element(alts.begin(), alts.end(), [](const auto& x, const auto& y) { return x.score < y.score; }) -
         alts.begin());
@@ -380,9 +385,14 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     const float margin = params_.verify.symmetry_margin;
     // ICP's pose stays unless an alternative beats it by the margin.
     const std::size_t chosen = best != 0 && alts[best].score >= alts[0].score + margin ? best : 0;
-    d.symmetry_chosen = static_cast<int>(chosen);
-    d.symmetry_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
-    d.ambiguous_symmetry = d.symmetry_margin < margin;
+    Detection& d = dets[i];
+    if (informative) d.colour_agreement = alts[chosen].colour;
+    if (turns) {
+      d.symmetry_chosen = static_cast<int>(chosen);
+      d.symmetry_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
+      d.ambiguous_symmetry = d.symmetry_margin < margin;
+      d.symmetry_alternatives = std::move(alts);
+    }
     if (chosen == 0) continue;
     // The turned pose shows other faces of the model: ICP and verification take those.
     initial[i].model_points = visibleModelPoints(views[chosen], poses[chosen], camera, window);
@@ -427,6 +437,10 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     else if (d.silhouette_support < vp.min_silhouette_support)
       d.rejection = fmt::format("only {:.0f}% of the outline shows a depth step (at least {:.0f}%)",
                                 100 * d.silhouette_support, 100 * vp.min_silhouette_support);
+    else if (d.colour_agreement < vp.min_colour_agreement)
+      d.rejection = fmt::format("its colours do not match the scene's (correlation {:.2f}, at least {:.2f}): "
+                                "something else of its shape?",
+                                d.colour_agreement, vp.min_colour_agreement);
     if (!d.rejection.empty()) {
       result.rejected.push_back(std::move(d));
       continue;

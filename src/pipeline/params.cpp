@@ -85,6 +85,8 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
   if (!(params.symmetry_margin >= 0.f && params.symmetry_margin <= 1.f))
     throw InputError(fmt::format("the symmetry margin must be in [0, 1], got {}", params.symmetry_margin));
+  if (!(params.min_colour_agreement >= -1.f && params.min_colour_agreement <= 1.f))
+    throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", params.min_colour_agreement));
 }
 
 void validateSensorParams(const SensorParams& p) {

@@ -13,7 +13,7 @@ namespace {
 constexpr int kMinBrightness = 60;
 /// A rendering whose chromaticity varies less than this (standard deviation) has no colour
 /// to compare: an uncoloured mesh renders grey.
-constexpr double kMinChromaSpread = 0.02;
+constexpr double kMinChromaSpread = 0.05;
 
 bool chroma(const cv::Vec3b& bgr, double& r, double& g) {
   const int sum = bgr[0] + bgr[1] + bgr[2];
