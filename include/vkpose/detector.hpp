@@ -70,6 +70,9 @@ struct Detection {
   int symmetry_chosen = 0;
   float symmetry_margin = 0.f;
   bool ambiguous_symmetry = false;
+  /// false: the mesh has no colours, so the alternatives were listed (angle and axis; scores
+  /// 0) but not rendered, and the pose is ambiguous.
+  bool symmetry_compared = true;
 };
 
 /// Milliseconds per stage, in pipeline order.

@@ -142,6 +142,7 @@ py::dict symmetryDict(const Detection& d) {
   out["alternatives"] = alternatives;
   out["chosen"] = d.symmetry_chosen;
   out["margin"] = tidy(d.symmetry_margin);
+  out["compared"] = d.symmetry_compared;
   return out;
 }
 

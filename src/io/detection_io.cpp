@@ -79,7 +79,8 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
                               {"score", round(a.score, 4)}});
     j["symmetry"] = {{"alternatives", std::move(alternatives)},
                      {"chosen", d.symmetry_chosen},
-                     {"margin", round(d.symmetry_margin, 4)}};
+                     {"margin", round(d.symmetry_margin, 4)},
+                     {"compared", d.symmetry_compared}};
     j["ambiguous_symmetry"] = d.ambiguous_symmetry;
   }
   if (!d.rejection.empty()) j["reason"] = d.rejection;
