@@ -2,10 +2,16 @@
 // it, and stored in the bank.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <Eigen/Geometry>
 
+#include "mesh_support.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
@@ -90,8 +96,8 @@ TEST(UpAxis, ViewsAreAboveItWithImageUpAlongIt) {
       EXPECT_NEAR(up_cam.x(), 0.f, 1e-4f) << name;
     }
     // viewsAbove measures from the up axis too.
-    EXPECT_EQ(viewsAbove(views, centre, 90.f, params.up).size(), views.size());
-    EXPECT_LT(viewsAbove(views, centre, 30.f, params.up).size(), views.size() / 2);
+    EXPECT_EQ(viewsAbove(views, centre, 90.f).size(), views.size());
+    EXPECT_LT(viewsAbove(views, centre, 30.f).size(), views.size() / 2);
   }
   // +z is what it always was: the same views as the hemisphere about +z gave before.
   params.up = Eigen::Vector3f::UnitZ();
@@ -106,6 +112,82 @@ TEST(UpAxis, ViewsAreAboveItWithImageUpAlongIt) {
   EXPECT_THROW(validateViewSampling(params), InputError);
 }
 
+std::vector<std::string> names(const std::vector<Eigen::Vector3f>& ups) {
+  std::vector<std::string> out;
+  for (const auto& u : ups) out.push_back(upAxisName(u));
+  return out;
+}
+
+TEST(UpAxis, OtherRestingPosesAreTheSidesItLiesOnThatNoNearSymmetryCovers) {
+  using Names = std::vector<std::string>;
+  // A brick stands on all six faces; its half-turns about x, y and z map each face onto the
+  // opposite one, so one face of each pair is enough.
+  const Mesh brick = test::boxMesh({0.08f, 0.05f, 0.12f});
+  const UpAxisChoice brick_choice = findUpAxis(brick);
+  const auto brick_turns = findNearSymmetries(brick, 0.03f * brick.diameter);
+  EXPECT_EQ(names(otherRestingUps(brick_choice, brick_choice.up, brick_turns)), (Names{"+y", "+x"}));
+  EXPECT_EQ(names(otherRestingUps(brick_choice, brick_choice.up, {})), (Names{"-z", "+y", "-y", "+x", "-x"}));
+  // A square prism's quarter-turns about its axis: its four sides are one.
+  const Mesh prism = test::boxMesh({0.06f, 0.06f, 0.2f});
+  const UpAxisChoice prism_choice = findUpAxis(prism);
+  EXPECT_EQ(names(otherRestingUps(prism_choice, prism_choice.up, findNearSymmetries(prism, 0.03f * prism.diameter))),
+            (Names{"+y"}));
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string d = test::sharedData() + "/meshes/";
+  for (const char* file : {"juicecarton.stl", "coffee_cup.stl", "milk.stl"}) {
+    const Mesh mesh = loadMesh(d + file);
+    const UpAxisChoice choice = findUpAxis(mesh);
+    const auto others = otherRestingUps(choice, choice.up, findNearSymmetries(mesh, 0.03f * mesh.diameter));
+    for (const Eigen::Vector3f& u : others) EXPECT_LT(u.dot(choice.up), 0.99f) << file;
+    // The carton lies on a side (one for all four), the cup stands on its rim, the jug lies on its flanks.
+    EXPECT_GE(others.size(), 1u) << file;
+    if (std::string(file) == "juicecarton.stl") {
+      EXPECT_EQ(others.size(), 1u) << fmt::format("{}", fmt::join(names(others), " "));
+    }
+  }
+}
+
+TEST(UpAxis, EachRestingPoseHasAHemisphereOfViews) {
+  ViewSamplingParams params;
+  params.viewpoints = 40;
+  params.radii = {0.7f, 0.8f, 0.1f};
+  params.inplane_deg = {-10.f, 10.f, 10.f};
+  params.up = parseUpAxis("+z");
+  params.other_ups = {parseUpAxis("+x"), parseUpAxis("-y")};
+  const Eigen::Vector3f centre(0.01f, 0.02f, -0.1f);
+  const auto views = sampleViews(params, centre);
+  ASSERT_EQ(views.size(), 3u * 40u * 2u * 3u);
+  std::set<int> viewpoints;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const TrainingView& v = views[i];
+    const Eigen::Vector3f expected_up = i < 240 ? params.up : params.other_ups[i < 480 ? 0 : 1];
+    EXPECT_LT((v.up - expected_up).norm(), 1e-6f) << i;
+    const Eigen::Vector3f camera = -(v.R.transpose() * v.t);
+    EXPECT_GT((camera - centre).normalized().dot(v.up), 0.f) << i;
+    viewpoints.insert(v.viewpoint);
+  }
+  EXPECT_EQ(viewpoints.size(), 120u);  // numbered on from one hemisphere to the next
+  // The first hemisphere is the one-up sampling, unchanged.
+  ViewSamplingParams one = params;
+  one.other_ups.clear();
+  const auto first = sampleViews(one, centre);
+  for (std::size_t i = 0; i < first.size(); ++i) EXPECT_EQ(first[i].R, views[i].R);
+  // viewsAbove measures each view from its own hemisphere's up.
+  EXPECT_EQ(viewsAbove(views, centre, 90.f).size(), views.size());
+  const auto near_top = viewsAbove(views, centre, 30.f);
+  EXPECT_LT(near_top.size(), views.size() / 2);
+  for (const auto& v : {parseUpAxis("+z"), parseUpAxis("+x"), parseUpAxis("-y")})
+    EXPECT_TRUE(std::any_of(near_top.begin(), near_top.end(), [&](const TrainingView& t) { return t.up == v; }));
+  // Nonsense is refused.
+  params.full_sphere = true;
+  EXPECT_THROW(validateViewSampling(params), InputError);
+  params.full_sphere = false;
+  params.other_ups = {Eigen::Vector3f(0.f, 0.f, 0.f)};
+  EXPECT_THROW(validateViewSampling(params), InputError);
+  params.other_ups.assign(6, Eigen::Vector3f::UnitX());
+  EXPECT_THROW(validateViewSampling(params), InputError);
+}
+
 TEST(UpAxis, TheBankKeepsIt) {
   const Mesh carton = demoMeshes()[1];
   TrainingParams params;
@@ -113,16 +195,21 @@ TEST(UpAxis, TheBankKeepsIt) {
   params.views.radii = {0.6f, 0.6f, 1.f};
   params.views.inplane_deg = {0.f, 0.f, 1.f};
   params.views.up = parseUpAxis("-y");
+  params.views.other_ups = {parseUpAxis("+x")};
   const TemplateBank bank = trainTemplates(test::context(), carton, params);
   const std::string path = (std::filesystem::temp_directory_path() / "vkpose_up_axis_test.vkpb").string();
   saveBank(bank, path);
   const TemplateBank back = loadBank(path);
   std::filesystem::remove(path);
   EXPECT_EQ(upAxisName(back.params.views.up), "-y");
-  // Every template was rendered from above -y.
-  for (const BankTemplate& t : back.templates) {
+  ASSERT_EQ(back.params.views.other_ups.size(), 1u);
+  EXPECT_EQ(upAxisName(back.params.views.other_ups[0]), "+x");
+  // Every template was rendered from above -y, then from above +x.
+  ASSERT_EQ(back.templates.size(), 6u);
+  for (std::size_t i = 0; i < back.templates.size(); ++i) {
+    const BankTemplate& t = back.templates[i];
     const Eigen::Vector3f camera = -(t.pose.R.transpose() * t.pose.t);
-    EXPECT_GT((camera - back.centre).dot(params.views.up), 0.f);
+    EXPECT_GT((camera - back.centre).dot(i < 3 ? params.views.up : params.views.other_ups[0]), 0.f) << i;
   }
 }
 

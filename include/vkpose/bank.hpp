@@ -40,9 +40,15 @@ struct ViewSamplingParams {
   /// image "up" follows it, so templates show the object as it stands. `vkpose train` finds it
   /// (findUpAxis) unless --up names one; +z is the modelling convention.
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  /// The up directions of the object's other resting poses (lying on a side, upside down;
+  /// object frame, unit): each adds a hemisphere of views about it, image up along it, so that
+  /// an object tipped over is still seen by some template. `vkpose train` finds them
+  /// (otherRestingUps) unless --resting up; none with the full sphere, which sees every side.
+  std::vector<Eigen::Vector3f> other_ups;
 };
 
-/// Throws InputError when the counts or ranges are out of bounds, or `up` is not a unit vector.
+/// Throws InputError when the counts or ranges are out of bounds, `up` or one of `other_ups` is
+/// not a unit vector, there are more than five other ups, or other ups come with the full sphere.
 void validateViewSampling(const ViewSamplingParams& params);
 
 // ---- the up axis -----------------------------------------------------------------------
@@ -114,6 +120,13 @@ std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m
 /// "180 deg about (0.00, 0.00, 1.00)" for messages.
 std::string describe(const NearSymmetry& s);
 
+/// The other poses the object rests in that training should also see (lying on a side, upside
+/// down): the axes of `choice.candidates` on which it stands (RestingCandidate::stands), less
+/// `up` and those that a near-symmetry turns into `up` or into one already kept (their views
+/// look the same: a square carton lying on any of its four sides). In the candidates' order.
+std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const Eigen::Vector3f& up,
+                                             const std::vector<NearSymmetry>& symmetries);
+
 /// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`
 /// (in object coordinates) on the optical axis at `distance`.
 struct TrainingView {
@@ -121,7 +134,9 @@ struct TrainingView {
   Eigen::Vector3f t = Eigen::Vector3f::Zero();
   float distance = 0.f;     ///< metres from the camera to the object's centre
   float inplane_deg = 0.f;  ///< in-plane rotation of this view
-  int viewpoint = 0;        ///< index of the viewpoint on the sphere
+  int viewpoint = 0;        ///< index of the viewpoint on the sphere (other ups' hemispheres follow on)
+  /// The up axis of the hemisphere the view is on (object frame): image up follows it.
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
 };
 
 /// Unit directions from the object's centre to the cameras: a Fibonacci lattice over the
@@ -135,14 +150,15 @@ TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f&
                         float inplane_deg, const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
 
 /// All views, viewpoint-major, then radius, then in-plane rotation; the (hemi)sphere's
-/// viewpoints turned so that its pole is `params.up`.
+/// viewpoints turned so that its pole is `params.up`, then those of a hemisphere about each of
+/// `params.other_ups`.
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre);
 
-/// The views whose camera sits within `max_polar_deg` of the object's up axis, seen from
-/// `centre`: for objects that only ever stand upright under a camera looking down, the rest
-/// of the hemisphere is templates that can only match wrongly.
+/// The views whose camera sits within `max_polar_deg` of their hemisphere's up axis
+/// (TrainingView::up), seen from `centre`: for objects that only ever stand upright under a
+/// camera looking down, the rest of the hemisphere is templates that can only match wrongly.
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
-                                     float max_polar_deg, const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
+                                     float max_polar_deg);
 
 // ---- LINEMOD templates -----------------------------------------------------------------
 
@@ -262,7 +278,8 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
 
 /// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
 /// FNV-1a 64 checksum of everything before it.
-constexpr uint32_t kBankVersion = 4;  // 2: the mesh is stored; 3: the up axis (2 reads as +z); 4: near-symmetries
+// 2: the mesh is stored; 3: the up axis (2 reads as +z); 4: near-symmetries; 5: other resting ups
+constexpr uint32_t kBankVersion = 5;
 void saveBank(const TemplateBank& bank, const std::string& path);
 /// Throws InputError naming the file and the problem: missing, not a bank, another version,
 /// truncated, or a checksum mismatch.

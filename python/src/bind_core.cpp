@@ -155,6 +155,14 @@ void bindCore(py::module_& m) {
       .def_property_readonly("up_axis", &upAxis,
                              "The object's up axis the views were sampled about ('+z', '-z', ...), mesh frame")
       .def_property_readonly(
+          "other_resting_ups",
+          [](const TemplateBank& b) {
+            py::list out;
+            for (const Eigen::Vector3f& u : b.params.views.other_ups) out.append(upAxisName(u));
+            return out;
+          },
+          "Up axes of the other resting poses (lying, upside down) whose views the bank also holds")
+      .def_property_readonly(
           "near_symmetries",
           [](const TemplateBank& b) {
             py::list out;
@@ -203,7 +211,8 @@ void bindCore(py::module_& m) {
       "train",
       [](const py::object& mesh_path, const std::string& units, int views, const py::object& radii,
          const py::object& inplane, const std::string& hemisphere, float max_view_angle, int features,
-         const py::object& camera, bool symmetric, const std::string& up, const py::object& device,
+         const py::object& camera, bool symmetric, const std::string& up, const std::string& resting,
+         const py::object& device,
          const py::object& cache_dir, const py::object& progress) {
         TrainingParams params;
         params.views.viewpoints = views;
@@ -216,6 +225,7 @@ void bindCore(py::module_& m) {
         params.symmetric = symmetric;
         if (!camera.is_none()) params.camera = cameraOf(camera, 640, 480, "camera");
         if (up != "auto") params.views.up = parseUpAxis(up);
+        if (resting != "all" && resting != "up") valueError(fmt::format("resting: '{}' is neither 'all' nor 'up'", resting));
         if (!(max_view_angle >= 1.f && max_view_angle <= 180.f))
           valueError(fmt::format("max_view_angle: {} is not within 1..180 degrees", max_view_angle));
         validateTrainingParams(params);
@@ -226,9 +236,13 @@ void bindCore(py::module_& m) {
         const auto report = progressOf(progress, "training");
         py::gil_scoped_release nogil;
         const Mesh mesh = loadMesh(path, mesh_units);
-        if (up == "auto") params.views.up = findUpAxis(mesh).up;
+        const UpAxisChoice choice = findUpAxis(mesh);
+        if (up == "auto") params.views.up = choice.up;
+        if (resting == "all" && !params.views.full_sphere)
+          params.views.other_ups = otherRestingUps(
+              choice, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
         const std::vector<TrainingView> training_views =
-            viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle, params.views.up);
+            viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle);
         if (training_views.empty())
           throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", max_view_angle));
         std::lock_guard<std::mutex> lock(dev->mutex);
@@ -241,7 +255,7 @@ void bindCore(py::module_& m) {
       py::arg("mesh"), py::kw_only(), py::arg("units") = "auto", py::arg("views") = 216,
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
-      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("device") = py::none(),
+      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "all", py::arg("device") = py::none(),
       py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
@@ -253,7 +267,9 @@ metres. inplane: in-plane rotations, degrees. hemisphere: 'upper' or 'full'. max
 keep viewpoints within this angle of the up axis, degrees. features: per modality and level.
 camera: the sensor (a Camera, a camera.json path, or a 3x3 K): templates are scale-specific.
 symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end it stands on,
-+z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. device: None, an index or a Device. cache_dir: a folder
++z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. resting: 'all' (also a
+hemisphere about each other pose it rests in, lying or upside down, that no near-symmetry covers)
+or 'up' (the up axis only). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

@@ -43,6 +43,8 @@ void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);
 /// The bank's near-symmetries, one line each (train and info --bank).
 void printNearSymmetries(const TemplateBank& bank);
+/// "+x up, -x up" (or "none") for the other resting poses' up axes.
+std::string restingUpsText(const std::vector<Eigen::Vector3f>& ups);
 /// `vkpose bench train`, registered under the `bench` subcommand; the runner runs it.
 Runner addBenchTrainCommand(CLI::App& bench, const GlobalOptions& global);
 /// `vkpose bench detect`, registered under the `bench` subcommand; the runner runs it.

@@ -8,6 +8,13 @@
 
 namespace vkpose::cli {
 
+std::string restingUpsText(const std::vector<Eigen::Vector3f>& ups) {
+  if (ups.empty()) return "none";
+  std::vector<std::string> names;
+  for (const Eigen::Vector3f& up : ups) names.push_back(upAxisName(up) + " up");
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
 void printNearSymmetries(const TemplateBank& bank) {
   if (bank.near_symmetries.empty()) {
     fmt::print("near-symmetries: none within {:.1f}% of the diameter\n", 100.f * bank.params.near_symmetry_tolerance);
@@ -34,8 +41,11 @@ void printBankSummary(const TemplateBank& bank, const std::string& path) {
   fmt::print("symmetric: {}\n", bank.symmetric ? "yes" : "no");
   fmt::print("templates: {}\n", bank.templates.size());
   fmt::print("up axis: {}\n", upAxisName(p.views.up));
+  fmt::print("other resting poses: {}\n", restingUpsText(p.views.other_ups));
   fmt::print("views: {} viewpoints ({}), radii {}:{}:{} m, in-plane {}:{}:{} deg\n", p.views.viewpoints,
-             p.views.full_sphere ? "full sphere" : "hemisphere above the up axis", p.views.radii.from, p.views.radii.to,
+             p.views.full_sphere            ? "full sphere"
+             : p.views.other_ups.empty() ? "hemisphere above the up axis"
+                                         : "a hemisphere above the up axis and one above each other resting pose's", p.views.radii.from, p.views.radii.to,
              p.views.radii.step, p.views.inplane_deg.from, p.views.inplane_deg.to, p.views.inplane_deg.step);
   fmt::print("features: {} per modality and level, T = {}, modalities {}{}, {:.1f} per template\n",
              p.features_per_modality, fmt::join(p.features.T, ","), p.features.use_colour ? "colour " : "",

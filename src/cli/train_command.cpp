@@ -17,7 +17,7 @@ using util::ProgressBar;
 namespace {
 struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
-      up = "auto";
+      up = "auto", resting = "all";
   int views = 216, features = 63;
   float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
   bool symmetric = false, force = false;
@@ -62,6 +62,12 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                   "-y, +z, -z. Views are sampled above it and image up follows it")
       ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}))
       ->capture_default_str();
+  sub->add_option("--resting", opt->resting,
+                  "all: views about every pose the object rests in (standing, lying on a side, upside down) that no "
+                  "near-symmetry already covers, a hemisphere each; up: only about the up axis (upright objects: "
+                  "fewer templates, faster matching)")
+      ->check(CLI::IsMember({"all", "up"}))
+      ->capture_default_str();
   sub->add_option("--max-view-angle", opt->max_view_angle,
                   "Keep only viewpoints within this angle of the object's up axis, degrees (e.g. 40 for parts that stand "
                   "upright under a camera looking down)")
@@ -92,8 +98,8 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                    unitName(report.units), report.file_diameter);
       fmt::print("diameter: {:.4f} m\n", mesh.diameter);
     }
+    const UpAxisChoice up = findUpAxis(mesh);
     if (opt->up == "auto") {
-      const UpAxisChoice up = findUpAxis(mesh);
       params.views.up = up.up;
       fmt::print("up axis: {} (auto: {})\n", upAxisName(up.up), up.reason);
       if (global.verbose)
@@ -104,12 +110,18 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
     } else {
       fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
     }
+    if (opt->resting == "all" && !params.views.full_sphere) {
+      params.views.other_ups = otherRestingUps(
+          up, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
+      fmt::print("other resting poses: {} ({})\n", restingUpsText(params.views.other_ups),
+                 params.views.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
+                                                : "a hemisphere of views about each; --resting up for upright only");
+    }
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);
     TrainingTimings timings;
     const std::vector<TrainingView> views =
-        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle,
-                   params.views.up);
+        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle);
     if (views.empty()) throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", opt->max_view_angle));
     const TemplateBank bank = trainTemplatesFromViews(
         ctx, mesh, params, views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);

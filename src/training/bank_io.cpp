@@ -160,6 +160,9 @@ void writeParams(Writer& w, const TrainingParams& p) {
   w.put(static_cast<int32_t>(p.camera.height));
   for (int i = 0; i < 3; ++i) w.put(p.views.up[i]);  // version 3
   w.put(p.near_symmetry_tolerance);                   // version 4
+  w.put(static_cast<uint32_t>(p.views.other_ups.size()));  // version 5
+  for (const Eigen::Vector3f& up : p.views.other_ups)
+    for (int i = 0; i < 3; ++i) w.put(up[i]);
 }
 
 void writePayload(Writer& w, const TemplateBank& bank) {
@@ -245,6 +248,13 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
     if (!p.views.up.allFinite() || std::abs(p.views.up.norm() - 1.f) > 1e-3f) r.fail("up axis is not a unit vector");
   }  // version 2 banks were all trained about +z
   if (version >= 4) p.near_symmetry_tolerance = r.get<float>();
+  if (version >= 5) {  // older banks saw one hemisphere
+    const auto ups = r.get<uint32_t>();
+    if (ups > 5) r.fail(fmt::format("{} other resting poses", ups));
+    p.views.other_ups.resize(ups);
+    for (Eigen::Vector3f& up : p.views.other_ups)
+      for (int i = 0; i < 3; ++i) up[i] = r.get<float>();
+  }
   try {
     validateTrainingParams(p);
   } catch (const InputError& e) {

@@ -157,4 +157,29 @@ UpAxisChoice findUpAxis(const Mesh& mesh) {
   return choice;
 }
 
+std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const Eigen::Vector3f& up,
+                                             const std::vector<NearSymmetry>& symmetries) {
+  // Views about u and about a turn of u look the same when the turn maps the surface onto
+  // itself: the object turned rests on u's side showing the same shape. Either direction of
+  // the turn, in case the list holds one of a pair.
+  constexpr float kSame = 0.99f;  // within 8 degrees
+  const auto covered = [&](const Eigen::Vector3f& u, const std::vector<Eigen::Vector3f>& seen) {
+    for (const Eigen::Vector3f& s : seen) {
+      if (u.dot(s) > kSame) return true;
+      for (const NearSymmetry& sym : symmetries) {
+        const Eigen::Matrix3f R = sym.transform().R;
+        if ((R * u).dot(s) > kSame || (R.transpose() * u).dot(s) > kSame) return true;
+      }
+    }
+    return false;
+  };
+  std::vector<Eigen::Vector3f> seen{up.normalized()}, out;
+  for (const RestingCandidate& c : choice.candidates) {
+    if (!c.stands() || covered(c.up, seen)) continue;
+    seen.push_back(c.up);
+    out.push_back(c.up);
+  }
+  return out;
+}
+
 }  // namespace vkpose

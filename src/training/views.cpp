@@ -59,8 +59,16 @@ void validateViewSampling(const ViewSamplingParams& p) {
   for (float a : p.inplane_deg.values())
     if (!(a >= -360.f && a <= 360.f))
       throw InputError(fmt::format("in-plane rotation {} degrees is outside -360 to 360", a));
-  if (!p.up.allFinite() || std::abs(p.up.norm() - 1.f) > 1e-3f)
-    throw InputError(fmt::format("up axis ({}, {}, {}) is not a unit vector", p.up.x(), p.up.y(), p.up.z()));
+  const auto checkUnit = [](const Eigen::Vector3f& up, const char* what) {
+    if (!up.allFinite() || std::abs(up.norm() - 1.f) > 1e-3f)
+      throw InputError(fmt::format("{} ({}, {}, {}) is not a unit vector", what, up.x(), up.y(), up.z()));
+  };
+  checkUnit(p.up, "up axis");
+  if (p.other_ups.size() > 5)
+    throw InputError(fmt::format("{} other resting poses: an object rests on at most six sides", p.other_ups.size()));
+  for (const Eigen::Vector3f& up : p.other_ups) checkUnit(up, "the up axis of another resting pose");
+  if (p.full_sphere && !p.other_ups.empty())
+    throw InputError("other resting poses with the full sphere: it already sees every side");
 }
 
 namespace {
@@ -106,36 +114,41 @@ TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f&
   v.t = Eigen::Vector3f(0.f, 0.f, distance) - v.R * centre;
   v.distance = distance;
   v.inplane_deg = inplane_deg;
+  v.up = object_up.normalized();
   return v;
 }
 
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre) {
   validateViewSampling(params);
-  const Eigen::Matrix3f turn = poleTo(params.up);
   const auto dirs = sphereViewpoints(params.viewpoints, params.full_sphere);
   const auto radii = params.radii.values();
   const auto angles = params.inplane_deg.values();
+  std::vector<Eigen::Vector3f> ups{params.up};
+  ups.insert(ups.end(), params.other_ups.begin(), params.other_ups.end());
   std::vector<TrainingView> views;
-  views.reserve(dirs.size() * radii.size() * angles.size());
-  for (std::size_t i = 0; i < dirs.size(); ++i)
-    for (float r : radii)
-      for (float a : angles) {
-        auto v = lookAtView(turn * dirs[i], centre, r, a, params.up);
-        v.viewpoint = static_cast<int>(i);
-        views.push_back(v);
-      }
+  views.reserve(ups.size() * dirs.size() * radii.size() * angles.size());
+  for (std::size_t k = 0; k < ups.size(); ++k) {
+    const Eigen::Matrix3f turn = poleTo(ups[k]);
+    for (std::size_t i = 0; i < dirs.size(); ++i)
+      for (float r : radii)
+        for (float a : angles) {
+          auto v = lookAtView(turn * dirs[i], centre, r, a, ups[k]);
+          v.viewpoint = static_cast<int>(k * dirs.size() + i);
+          views.push_back(v);
+        }
+  }
   return views;
 }
 
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
-                                     float max_polar_deg, const Eigen::Vector3f& up) {
+                                     float max_polar_deg) {
   if (!(max_polar_deg > 0.f && max_polar_deg <= 180.f))
     throw InputError(fmt::format("the largest angle from the top must be in (0, 180] degrees, not {}", max_polar_deg));
   const float min_cos = std::cos(max_polar_deg * std::numbers::pi_v<float> / 180.f);
   std::vector<TrainingView> out;
   for (const TrainingView& v : views) {
     const Eigen::Vector3f camera = -(v.R.transpose() * v.t);  // the camera's centre, object frame
-    if ((camera - centre).normalized().dot(up.normalized()) >= min_cos - 1e-6f) out.push_back(v);
+    if ((camera - centre).normalized().dot(v.up) >= min_cos - 1e-6f) out.push_back(v);
   }
   return out;
 }
