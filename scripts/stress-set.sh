@@ -4,14 +4,19 @@
 # carton as it is; Tejani et al.'s poses, six clutter boxes and cylinders an image; every bank
 # searched on every frame. Trains the banks with the defaults (--units m and nothing else),
 # renders one dataset per seed and evaluates each, with a precision-recall plot.
-#   bash scripts/stress-set.sh OUT_DIR [SEED ...]      (default seeds: 31 32 33; about 10 minutes
-#                                                       on 2 cores, most of it training)
+#   bash scripts/stress-set.sh [--lying] OUT_DIR [SEED ...]   (default seeds: 31 32 33; about 10
+#                                                              minutes on 2 cores, most of it training)
+# --lying: also random placements on a table (most instances lying on a side or upside down,
+# `synth --poses random`), 6 images a seed, searched with banks trained --resting all (about
+# 15 more minutes of training).
 # Needs ../shared/data and a build (VKPOSE=path/to/vkpose, default build/release/vkpose).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 vkpose="${VKPOSE:-$root/build/release/vkpose}"
 data="$root/../shared/data"
-[ $# -ge 1 ] || { sed -n 2,9p "$0"; exit 2; }
+lying=0
+[ "${1:-}" = "--lying" ] && { lying=1; shift; }
+[ $# -ge 1 ] || { sed -n 2,12p "$0"; exit 2; }
 out="$1"; shift
 seeds=("${@:-31 32 33}")
 [ -x "$vkpose" ] || { echo "stress-set: no $vkpose; build first" >&2; exit 1; }
@@ -31,4 +36,17 @@ for seed in ${seeds[@]}; do
     --mesh "$out/meshes/milk.stl" --units m --poses "$data/tejani_poses" --images 9 --clutter 6 --seed "$seed" --out "$set"
   "$vkpose" eval --dataset "$set" --bank 1="$out/juicecarton.vkpb" --bank 2="$out/coffee_cup.vkpb" \
     --bank 3="$out/milk.vkpb" --method vkpose --report "$set-report.json" --pr-curve "$set-pr.svg" --force
+done
+[ "$lying" = 1 ] || exit 0
+for m in juicecarton.ply coffee_cup.ply milk.stl; do
+  bank="$out/${m%.*}-all.vkpb"
+  [ -f "$bank" ] || "$vkpose" train "$out/meshes/$m" --units m --resting all --out "$bank"
+done
+for seed in ${seeds[@]}; do
+  set="$out/lying$seed"
+  [ -d "$set" ] || "$vkpose" synth --mesh "$out/meshes/juicecarton.ply" --mesh "$out/meshes/coffee_cup.ply" \
+    --mesh "$out/meshes/milk.stl" --units m --poses random --layout table --instances 1:2 --images 6 --clutter 6 \
+    --seed "$seed" --out "$set"
+  "$vkpose" eval --dataset "$set" --bank 1="$out/juicecarton-all.vkpb" --bank 2="$out/coffee_cup-all.vkpb" \
+    --bank 3="$out/milk-all.vkpb" --method vkpose --report "$set-report.json" --pr-curve "$set-pr.svg" --force
 done

@@ -108,7 +108,8 @@ TEST(Appearance, ColourTellsAPaintedPrismsTurnsApartAndDepthCannot) {
   const SeenScene scene = seen(prism, camera, truth);
   const cv::Rect frame(0, 0, camera.width, camera.height);
   const auto compare = [&](const Mesh& mesh, const Pose& pose) {
-    return appearanceAgreement(renderReference(mesh, camera, pose), frame, scene.bgr, scene.depth, 0.01f);
+    return appearanceAgreement(renderReference(mesh, camera, pose), frame, scene.bgr, scene.depth, 0.01f,
+                               meshChromaSpread(mesh) >= kMinChromaSpread);
   };
   const AppearanceAgreement right = compare(prism, truth);
   EXPECT_TRUE(right.colour_informative);
@@ -125,15 +126,36 @@ TEST(Appearance, ColourTellsAPaintedPrismsTurnsApartAndDepthCannot) {
     EXPECT_FALSE(blind.colour_informative);
     EXPECT_NEAR(blind.score, compare(grey, truth).score, 0.05f) << describe(s);
   }
+  // Seen square-on, a face shows one colour: the means tell the faces apart (a box lying
+  // down shows one painted side), on the same scale as the painted alternatives above.
+  Pose face_on;
+  face_on.R = Eigen::AngleAxisf(EIGEN_PI / 2, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  face_on.t = {0.f, 0.f, 0.6f};
+  const SeenScene face_scene = seen(prism, camera, face_on);
+  const auto compareFace = [&](const Pose& pose) {
+    return appearanceAgreement(renderReference(prism, camera, pose), frame, face_scene.bgr, face_scene.depth, 0.01f,
+                               true);
+  };
+  const AppearanceAgreement face_right = compareFace(face_on);
+  EXPECT_GT(face_right.colour, 0.7f);
+  for (const float angle : {90.f, 180.f}) {
+    const Pose turned = compose(face_on, Pose{Eigen::AngleAxisf(angle * EIGEN_PI / 180.f, Eigen::Vector3f::UnitZ())
+                                                  .toRotationMatrix(),
+                                              Eigen::Vector3f::Zero()});
+    const AppearanceAgreement face_wrong = compareFace(turned);
+    EXPECT_GT(face_wrong.depth_fit, 0.95f) << angle;
+    EXPECT_LT(face_wrong.colour, 0.4f) << angle;
+    EXPECT_GT(face_right.score, face_wrong.score + 0.15f) << angle;
+  }
   // Something in front hides the object: hidden pixels do not count against it.
   SeenScene occluded = scene;
   occluded.depth(cv::Rect(0, 0, camera.width / 2 + 20, camera.height)).setTo(0.3f);
   const AppearanceAgreement half =
-      appearanceAgreement(renderReference(prism, camera, truth), frame, occluded.bgr, occluded.depth, 0.01f);
+      appearanceAgreement(renderReference(prism, camera, truth), frame, occluded.bgr, occluded.depth, 0.01f, true);
   EXPECT_LT(half.pixels, right.pixels);
   EXPECT_GT(half.depth_fit, 0.98f);
   EXPECT_THROW(appearanceAgreement(renderReference(prism, camera, truth), cv::Rect(0, 0, 10, 10), scene.bgr,
-                                   scene.depth, 0.01f),
+                                   scene.depth, 0.01f, true),
                InputError);
 }
 

@@ -163,7 +163,7 @@ struct VerifyParams {
   /// is flagged ambiguous_symmetry (always so for an uncoloured mesh).
   bool resolve_symmetries = true;
   float symmetry_margin = 0.05f;
-  /// For meshes with colours that vary: the kept pose's rendered chromaticity must correlate
+  /// For meshes with colours that vary: the kept pose's rendered chromaticity must agree
   /// with the frame's at least this much (a cup-shaped can, a carton's twin in other colours
   /// fit the depth as well as the object). -1: off.
   float min_colour_agreement = 0.2f;

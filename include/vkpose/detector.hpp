@@ -30,7 +30,7 @@ struct SymmetryAlternative {
   float angle_deg = 0.f;                            ///< 0: ICP's own pose
   Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();  ///< object frame
   float depth_fit = 0.f;  ///< share of the visible rendered pixels within tolerance of the scene's depth
-  float colour = 0.f;     ///< correlation of rendered and seen chromaticity, -1..1 (0 without colour)
+  float colour = 0.f;     ///< agreement of rendered and seen chromaticity (appearance.hpp), -1..1 (0 without colour)
   float score = 0.f;      ///< depth_fit * (1 + colour) / 2 with colour, else depth_fit
 };
 
@@ -123,6 +123,8 @@ class Detector {
   std::unique_ptr<LinemodMatcher> matcher_;
   std::unique_ptr<ClusterScorer> scorer_;
   std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stage 6
+  /// per bank: its mesh's colours vary enough to tell poses and look-alikes apart (meshChromaSpread)
+  std::vector<bool> colourful_;
   std::vector<float> bounding_radius_;  ///< per bank: farthest mesh vertex from the bank's centre (stage 6's windows)
 
   const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running

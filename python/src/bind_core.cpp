@@ -255,7 +255,7 @@ void bindCore(py::module_& m) {
       py::arg("mesh"), py::kw_only(), py::arg("units") = "auto", py::arg("views") = 216,
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
-      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "all", py::arg("device") = py::none(),
+      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "up", py::arg("device") = py::none(),
       py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
@@ -267,9 +267,9 @@ metres. inplane: in-plane rotations, degrees. hemisphere: 'upper' or 'full'. max
 keep viewpoints within this angle of the up axis, degrees. features: per modality and level.
 camera: the sensor (a Camera, a camera.json path, or a 3x3 K): templates are scale-specific.
 symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end it stands on,
-+z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. resting: 'all' (also a
-hemisphere about each other pose it rests in, lying or upside down, that no near-symmetry covers)
-or 'up' (the up axis only). device: None, an index or a Device. cache_dir: a folder
++z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. resting: 'up' (views about
+the up axis only) or 'all' (also a hemisphere about each other pose it rests in, lying or upside
+down, that no near-symmetry covers: up to 6x the templates). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

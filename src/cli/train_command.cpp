@@ -17,7 +17,7 @@ using util::ProgressBar;
 namespace {
 struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
-      up = "auto", resting = "all";
+      up = "auto", resting = "up";
   int views = 216, features = 63;
   float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
   bool symmetric = false, force = false;
@@ -63,9 +63,9 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}))
       ->capture_default_str();
   sub->add_option("--resting", opt->resting,
-                  "all: views about every pose the object rests in (standing, lying on a side, upside down) that no "
-                  "near-symmetry already covers, a hemisphere each; up: only about the up axis (upright objects: "
-                  "fewer templates, faster matching)")
+                  "up: views about the up axis only (objects standing upright); all: also a hemisphere about each "
+                  "other pose the object rests in (lying on a side, upside down) that no near-symmetry covers, for "
+                  "objects tipped over or in bins: up to 6x the templates and the matching time")
       ->check(CLI::IsMember({"all", "up"}))
       ->capture_default_str();
   sub->add_option("--max-view-angle", opt->max_view_angle,
@@ -110,12 +110,14 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
     } else {
       fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
     }
-    if (opt->resting == "all" && !params.views.full_sphere) {
-      params.views.other_ups = otherRestingUps(
+    if (!params.views.full_sphere) {
+      const std::vector<Eigen::Vector3f> others = otherRestingUps(
           up, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
-      fmt::print("other resting poses: {} ({})\n", restingUpsText(params.views.other_ups),
-                 params.views.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
-                                                : "a hemisphere of views about each; --resting up for upright only");
+      if (opt->resting == "all") params.views.other_ups = others;
+      fmt::print("other resting poses: {} ({})\n", restingUpsText(others),
+                 others.empty()                ? "it stands on no other side, or near-symmetries cover them"
+                 : opt->resting == "all" ? "a hemisphere of views about each as well"
+                                         : "not trained: pass --resting all to find it lying down too");
     }
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);

@@ -88,7 +88,7 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"verify", "symmetry_margin", "score an alternative needs over ICP's pose to replace it; closer: ambiguous, 0..1",
        &p.verify.symmetry_margin},
       {"verify", "min_colour_agreement",
-       "meshes with colours: the pose's rendered chromaticity must correlate with the frame's this much (-1: off)",
+       "meshes with colours: the pose's rendered chromaticity must agree with the frame's this much (-1: off)",
        &p.verify.min_colour_agreement},
       {"sensor", "axial_sigma_at_1m", "depth noise sigma(z) = this * z^2, metres at 1 m", &p.sensor.axial_sigma_at_1m},
       {"sensor", "quantization_m", "the depth images' step, metres", &p.sensor.quantization_m},

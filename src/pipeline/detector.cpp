@@ -92,6 +92,7 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   for (std::size_t b = 0; b < banks_.size(); ++b)
     for (const auto& v : banks_[b].mesh.vertices)
       bounding_radius_[b] = std::max(bounding_radius_[b], (v - banks_[b].centre).norm());
+  for (const auto& b : banks_) colourful_.push_back(meshChromaSpread(b.mesh) >= kMinChromaSpread);
 }
 
 Detector::~Detector() = default;
@@ -354,8 +355,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
     const auto& symmetries = banks_[b].near_symmetries;
     if (!initial[i].ok || !verified[i].accepted) continue;
-    if (banks_[b].mesh.colours.empty()) {
-      // Nothing to compare but depth, and the turns fit the depth within the training
+    if (!colourful_[b]) {
+      // No colours that vary (none, or one colour all over: LM-O's scans vary too little):
+      // nothing to compare but depth, and the turns fit the depth within the training
       // tolerance by construction (ICP has had its say): listed, not rendered (on IC-BIN
       // rendering the cup's 7 turns cost 230 ms a frame to say "ambiguous").
       if (!params_.verify.resolve_symmetries || symmetries.empty()) continue;
@@ -382,7 +384,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     bool informative = false;
     for (std::size_t k = 0; k < poses.size(); ++k) {
       const AppearanceAgreement a =
-          appearanceAgreement(views[k], window, scene_bgr, scene.depth_m, verify_params[i].see_through_tolerance);
+          appearanceAgreement(views[k], window, scene_bgr, scene.depth_m, verify_params[i].see_through_tolerance, true);
       SymmetryAlternative alt;
       if (k > 0) alt.angle_deg = symmetries[k - 1].angle_deg, alt.axis = symmetries[k - 1].axis;
       alt.depth_fit = a.depth_fit;
@@ -453,7 +455,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
       d.rejection = fmt::format("only {:.0f}% of the outline shows a depth step (at least {:.0f}%)",
                                 100 * d.silhouette_support, 100 * vp.min_silhouette_support);
     else if (d.colour_agreement < vp.min_colour_agreement)
-      d.rejection = fmt::format("its colours do not match the scene's (correlation {:.2f}, at least {:.2f}): "
+      d.rejection = fmt::format("its colours do not match the scene's (agreement {:.2f}, at least {:.2f}): "
                                 "something else of its shape?",
                                 d.colour_agreement, vp.min_colour_agreement);
     if (!d.rejection.empty()) {

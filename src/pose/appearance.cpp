@@ -1,6 +1,7 @@
 // Render and compare for near-symmetric poses (appearance.hpp).
 #include "pose/appearance.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "vkpose/error.hpp"
@@ -11,9 +12,8 @@ namespace {
 
 /// Below this r+g+b (of 765) a pixel's chromaticity is mostly noise: shadows, dark paint.
 constexpr int kMinBrightness = 60;
-/// A rendering whose chromaticity varies less than this (standard deviation) has no colour
-/// to compare: an uncoloured mesh renders grey.
-constexpr double kMinChromaSpread = 0.05;
+/// Fewer pixels with a chromaticity than this: too few to say anything about colour.
+constexpr int kMinColourPixels = 20;
 
 bool chroma(const cv::Vec3b& bgr, double& r, double& g) {
   const int sum = bgr[0] + bgr[1] + bgr[2];
@@ -25,8 +25,21 @@ bool chroma(const cv::Vec3b& bgr, double& r, double& g) {
 
 }  // namespace
 
+double meshChromaSpread(const Mesh& mesh) {
+  if (mesh.colours.empty()) return 0.0;
+  double n = 0, sr = 0, sg = 0, ss = 0;
+  for (const Eigen::Vector3f& c : mesh.colours) {
+    const double sum = static_cast<double>(c.x()) + c.y() + c.z();
+    if (sum < kMinBrightness / 255.0) continue;
+    const double r = c.x() / sum, g = c.y() / sum;
+    n += 1, sr += r, sg += g, ss += r * r + g * g;
+  }
+  if (n < 2) return 0.0;
+  return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
+}
+
 AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr,
-                                        const cv::Mat& scene_depth_m, float depth_tolerance) {
+                                        const cv::Mat& scene_depth_m, float depth_tolerance, bool colour_counts) {
   if (scene_bgr.type() != CV_8UC3 || scene_depth_m.type() != CV_32FC1 || scene_bgr.size() != scene_depth_m.size())
     throw InputError("appearanceAgreement: colour and depth must be 8-bit BGR and float depth of one size");
   if (rendering.depth.size() != window.size() || rendering.bgr.size() != window.size())
@@ -57,13 +70,20 @@ AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Re
   if (out.pixels == 0) return out;
   out.depth_fit = static_cast<float>(fits) / static_cast<float>(out.pixels);
   out.score = out.depth_fit;
-  if (n < 2) return out;
+  if (!colour_counts || n < kMinColourPixels) return out;
   const double var_a = saa / n - (sa_r * sa_r + sa_g * sa_g) / (n * n);
   const double var_b = sbb / n - (sb_r * sb_r + sb_g * sb_g) / (n * n);
   const double cov = sab / n - (sa_r * sb_r + sa_g * sb_g) / (n * n);
-  if (var_a < kMinChromaSpread * kMinChromaSpread) return out;
+  const double dr = (sa_r - sb_r) / n, dg = (sa_g - sb_g) / n;
+  // Lin's concordance, leaning on the means only where the rendering is of about one colour
+  // (weight w): there the mean is all that can tell one painted face from another, and a
+  // floor makes two single colours that agree score near 1 rather than 0/0. Where the
+  // rendering's colours vary, w fades and what is left is about a correlation: blind to a
+  // tinted light, and near 0 for a plain look-alike.
+  const double base = kMinChromaSpread * kMinChromaSpread;
+  const double w = base / (base + std::max(0.0, var_a));
   out.colour_informative = true;
-  out.colour = var_b > 1e-12 ? static_cast<float>(cov / std::sqrt(var_a * var_b)) : 0.f;
+  out.colour = static_cast<float>((2.0 * cov + w * base) / (var_a + var_b + w * (dr * dr + dg * dg) + w * base));
   out.score = out.depth_fit * 0.5f * (1.f + out.colour);
   return out;
 }

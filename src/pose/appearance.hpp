@@ -11,19 +11,31 @@ namespace vkpose {
 struct AppearanceAgreement {
   int pixels = 0;          ///< rendered pixels with scene depth that nothing in front hides
   float depth_fit = 0.f;   ///< share of them within the tolerance of the scene's depth
-  /// Correlation (-1..1) of the rendered and the scene's chromaticity (r, g of r+g+b: blind to
-  /// shading and brightness) over the fitting pixels that are bright enough to have one.
+  /// Concordance (-1..1) of the rendered and the scene's chromaticity (r, g of r+g+b: blind to
+  /// shading and brightness) over the fitting pixels that are bright enough to have one:
+  /// 2 cov / (var_rendered + var_seen + w |mean difference|^2), w = 1 where the rendering is of
+  /// about one colour and fading as its colours vary (then it is about a correlation). Unlike a correlation it is defined where the rendering shows one
+  /// colour (one painted face of a box lying down): 1 when the seen face has that colour, near
+  /// 0 when another, so every alternative of a pose is scored on one scale.
   float colour = 0.f;
-  /// The rendering has colour that varies (a painted mesh): colour counts. False for an
-  /// uncoloured mesh (grey shading) or a single-coloured one.
+  /// Colour counted (the caller said the mesh has colours that vary, and enough pixels had one).
   bool colour_informative = false;
   /// depth_fit * (1 + colour) / 2 where colour counts, else depth_fit.
   float score = 0.f;
 };
 
+/// Below this spread (standard deviation of (r, g) chromaticity) colours do not tell places
+/// apart: an uncoloured mesh renders grey, a single-coloured one is its own look-alike.
+constexpr double kMinChromaSpread = 0.05;
+
+/// The spread of a mesh's vertex colours' chromaticity (0 without colours): the detector lets
+/// colour count for meshes of at least kMinChromaSpread.
+double meshChromaSpread(const Mesh& mesh);
+
 /// `rendering` covers `window` of the scene (MeshRenderer::render through windowCamera).
 /// scene_bgr: CV_8UC3, scene_depth_m: CV_32FC1 (0 = none), both full frames of one size.
+/// Without `colour_counts` the score is the depth fit alone.
 AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr,
-                                        const cv::Mat& scene_depth_m, float depth_tolerance);
+                                        const cv::Mat& scene_depth_m, float depth_tolerance, bool colour_counts);
 
 }  // namespace vkpose
