@@ -14,9 +14,10 @@ struct AppearanceAgreement {
   /// Concordance (-1..1) of the rendered and the scene's chromaticity (r, g of r+g+b: blind to
   /// shading and brightness) over the fitting pixels that are bright enough to have one:
   /// 2 cov / (var_rendered + var_seen + w |mean difference|^2), w = 1 where the rendering is of
-  /// about one colour and fading as its colours vary (then it is about a correlation). Unlike a correlation it is defined where the rendering shows one
-  /// colour (one painted face of a box lying down): 1 when the seen face has that colour, near
-  /// 0 when another, so every alternative of a pose is scored on one scale.
+  /// about one colour and fading as its colours vary (then it is about a correlation). Unlike a
+  /// correlation it is defined where the rendering shows one colour (one painted face of a box
+  /// lying down): 1 when the seen face has that colour, near 0 when another, so every
+  /// alternative of a pose is scored on one scale.
   float colour = 0.f;
   /// Colour counted (the caller said the mesh has colours that vary, and enough pixels had one).
   bool colour_informative = false;
