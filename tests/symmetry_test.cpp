@@ -294,5 +294,96 @@ TEST(NearSymmetries, TheSharedMeshesAtTheDefaultTolerance) {
   EXPECT_TRUE(find("milk.stl").empty());
 }
 
+// Look-alike half-turns: beyond the near-symmetry tolerance, within 6 % of the diameter.
+TEST(NearSymmetries, LookAlikeHalfTurnsAreTheCartonEndForEndAndTheJugFlankForFlank) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const std::string d = test::sharedData() + "/meshes/";
+  const auto find = [&](const char* name) {
+    const Mesh mesh = loadMesh(d + name);
+    return findLookAlikeTurns(mesh, 0.03f * mesh.diameter, 0.06f * mesh.diameter);
+  };
+  // The carton end for end: a half-turn across its long axis (its gable top is not its base).
+  const auto carton = find("juicecarton.stl");
+  ASSERT_FALSE(carton.empty());
+  for (const auto& s : carton) {
+    EXPECT_EQ(s.angle_deg, 180.f);
+    EXPECT_LT(std::abs(s.axis.z()), 0.1f) << describe(s);
+  }
+  // The jug flank for flank: a half-turn about its upright axis (the spout is off it).
+  const auto milk = find("milk.stl");
+  ASSERT_FALSE(milk.empty());
+  EXPECT_GT(std::abs(milk.front().axis.z()), 0.95f) << describe(milk.front());
+  for (const auto& s : milk) EXPECT_GT(s.deviation_m, 0.03f * loadMesh(d + "milk.stl").diameter);
+  // A square prism's half-turns are exact: near-symmetries, not look-alikes.
+  const Mesh prism = test::boxMesh({0.06f, 0.06f, 0.16f});
+  EXPECT_TRUE(findLookAlikeTurns(prism, 0.03f * prism.diameter, 0.06f * prism.diameter).empty());
+  EXPECT_TRUE(findLookAlikeTurns(prism, 0.06f, 0.03f).empty());
+}
+
+// The lying carton (--resting all's +y hemisphere): its templates cannot tell the gable top
+// from the flat base, so stage 6 settles either way up; the look-alike check turns it back.
+TEST(NearSymmetries, LyingCartonsEndForEndAreTurnedBack) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const Mesh carton = painted(loadMesh(test::sharedData() + "/meshes/juicecarton.stl", MeshUnits::Metres));
+  TrainingParams params;
+  params.views.viewpoints = 100;
+  params.views.radii = {0.7f, 0.9f, 0.1f};
+  params.views.inplane_deg = {-20.f, 20.f, 10.f};
+  params.views.up = Eigen::Vector3f::UnitY();
+  const TemplateBank bank = test::cachedBank(carton, params);
+
+  // Three cartons lying on their +y sides, turned every way on the table, seen from 0.8 m.
+  const Camera camera = tejaniCamera();
+  const Mesh table = planeMesh(1.2f);
+  const TrainingView view = lookAtView(Eigen::Vector3f(0.f, -0.5f, 1.f).normalized(), Eigen::Vector3f::Zero(), 0.8f, 0.f);
+  const Pose world{view.R, view.t};
+  std::vector<Pose> truth;
+  std::vector<SceneObject> objects{{&table, world}};
+  const float yaws[3] = {0.3f, 2.4f, 4.4f};
+  const Eigen::Vector3f at[3] = {{-0.14f, 0.05f, 0.f}, {0.03f, -0.08f, 0.f}, {0.15f, 0.06f, 0.f}};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Matrix3f R = Eigen::AngleAxisf(yaws[k], Eigen::Vector3f::UnitZ()).toRotationMatrix() *
+                              Eigen::AngleAxisf(static_cast<float>(EIGEN_PI) / 2, Eigen::Vector3f::UnitX());
+    truth.push_back(compose(world, Pose{R, at[k] - Eigen::Vector3f(0.f, 0.f, carton.bbox_min.y())}));
+  }
+  for (const auto& p : truth) objects.push_back({&carton, p});
+  SceneRendering scene = renderScene(test::context(), objects, camera);
+  Lighting light;
+  light.direction = Eigen::Vector3f(0.3f, 0.5f, 1.f).normalized();
+  applyLighting(scene, light);
+  const LinemodFrame frame = sensorFrame(scene, synthNoise(), 11);
+
+  const auto detectWith = [&](float look_alike_tolerance) {
+    DetectorParams dp;
+    dp.verify.look_alike_tolerance = look_alike_tolerance;
+    Detector detector(test::context(), {bank}, dp);
+    return detector.detect(frame, camera);
+  };
+  const DetectionResult result = detectWith(DetectorParams{}.verify.look_alike_tolerance);
+  int found = 0;
+  for (const Detection& d : result.detections) {
+    ASSERT_GE(d.look_alike_alternatives.size(), 2u);  // the pose and at least one turn
+    EXPECT_EQ(d.look_alike_alternatives.front().angle_deg, 0.f);
+    EXPECT_EQ(d.look_alike_alternatives[1].angle_deg, 180.f);
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      if ((d.pose.t - truth[k].t).norm() > 0.02f) continue;
+      ++found;
+      EXPECT_LT(angleDeg(d.pose.R, truth[k].R), 10.f)
+          << "carton " << k << ": look-alike " << d.look_alike_chosen << " by " << d.look_alike_margin;
+    }
+  }
+  EXPECT_GE(found, 2) << result.detections.size() << " detections";
+  EXPECT_NE(detectionJson(result, {}).find("\"look_alike_turns\""), std::string::npos);
+
+  // Without it (for the record; stage 6 decides which way up ICP starts).
+  int flipped = 0;
+  for (const Detection& d : detectWith(0.f).detections) {
+    EXPECT_TRUE(d.look_alike_alternatives.empty());
+    for (const auto& t : truth)
+      if ((d.pose.t - t.t).norm() < 0.03f && angleDeg(d.pose.R, t.R) > 45.f) ++flipped;
+  }
+  std::printf("without the look-alike check, %d of 3 lying cartons are found the wrong way round\n", flipped);
+}
+
 }  // namespace
 }  // namespace vkpose

@@ -117,6 +117,14 @@ struct NearSymmetry {
 /// tolerance <= 0 gives none.
 std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count = 7);
 
+/// Half-turns that nearly map the surface onto itself but not within the near-symmetry
+/// tolerance: the ones detection may still confuse with the pose (a carton turned end for
+/// end, 8 mm off; a jug turned flank for flank, 9 mm off). Half-turns about the same axes
+/// as findNearSymmetries, kept when their deviation lies in (from_m, to_m]; sorted by
+/// deviation, at most `max_count`. The detector refits each after ICP and lets depth (and
+/// colour) choose (VerifyParams::look_alike_tolerance). Empty when to_m <= from_m.
+std::vector<NearSymmetry> findLookAlikeTurns(const Mesh& mesh, float from_m, float to_m, int max_count = 3);
+
 /// "180 deg about (0.00, 0.00, 1.00)" for messages.
 std::string describe(const NearSymmetry& s);
 

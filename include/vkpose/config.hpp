@@ -163,6 +163,13 @@ struct VerifyParams {
   /// is flagged ambiguous_symmetry (always so for an uncoloured mesh).
   bool resolve_symmetries = true;
   float symmetry_margin = 0.05f;
+  /// Look-alike half-turns (findLookAlikeTurns): turns that map the surface onto itself
+  /// within this share of the diameter but not within the near-symmetry tolerance. Such a
+  /// turn does not fit the depth as well as the pose, but templates cannot tell them apart
+  /// (a lying carton end for end). Each accepted pose is turned, refit by ICP from there,
+  /// and the two are rendered and compared by colour and the depth residual over the whole
+  /// mask; the turn replaces the pose when it scores symmetry_margin higher. 0: off.
+  float look_alike_tolerance = 0.06f;
   /// For meshes with colours that vary: the kept pose's rendered chromaticity must agree
   /// with the frame's at least this much (a cup-shaped can, a carton's twin in other colours
   /// fit the depth as well as the object). -1: off.

@@ -32,6 +32,9 @@ struct SymmetryAlternative {
   float depth_fit = 0.f;  ///< share of the visible rendered pixels within tolerance of the scene's depth
   float colour = 0.f;     ///< agreement of rendered and seen chromaticity (appearance.hpp), -1..1 (0 without colour)
   float score = 0.f;      ///< depth_fit * (1 + colour) / 2 with colour, else depth_fit
+  /// Mean distance of the visible rendered pixels' depth from the scene's, each capped at
+  /// the tolerance (metres; look-alike turns only, where it is part of the score).
+  float depth_residual_m = 0.f;
 };
 
 /// One detected object instance.
@@ -73,6 +76,13 @@ struct Detection {
   /// false: the mesh has no colours, so the alternatives were listed (angle and axis; scores
   /// 0) but not rendered, and the pose is ambiguous.
   bool symmetry_compared = true;
+  /// Look-alike half-turns (VerifyParams::look_alike_tolerance) refit by ICP and compared,
+  /// the kept pose first (angle 0); score = depth_fit * (1 - residual / tolerance), times
+  /// (1 + colour) / 2 with colour. Chosen: the index kept; margin: by how much it beat the
+  /// best other. Empty when the object has none or the pose was not accepted so far.
+  std::vector<SymmetryAlternative> look_alike_alternatives;
+  int look_alike_chosen = 0;
+  float look_alike_margin = 0.f;
 };
 
 /// Milliseconds per stage, in pipeline order.
@@ -125,6 +135,9 @@ class Detector {
   std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stage 6
   /// per bank: its mesh's colours vary enough to tell poses and look-alikes apart (meshChromaSpread)
   std::vector<bool> colourful_;
+  /// per bank: findLookAlikeTurns beyond the bank's near-symmetry tolerance, up to
+  /// VerifyParams::look_alike_tolerance (found from the mesh when the detector is built)
+  std::vector<std::vector<NearSymmetry>> look_alike_turns_;
   std::vector<float> bounding_radius_;  ///< per bank: farthest mesh vertex from the bank's centre (stage 6's windows)
 
   const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running

@@ -125,24 +125,41 @@ py::array_t<double> poseMatrix(const Pose& p) {
   return out;
 }
 
-/// The near-symmetric poses compared: {"alternatives": [{"angle_deg", "axis", "depth_fit",
-/// "colour", "score"}], "chosen": index, "margin": by how much it won}.
-py::dict symmetryDict(const Detection& d) {
-  py::list alternatives;
-  for (const auto& a : d.symmetry_alternatives) {
+/// Poses compared with a detection's: [{"angle_deg", "axis", "depth_fit", ("depth_residual_mm"),
+/// "colour", "score"}].
+py::list alternativesList(const std::vector<SymmetryAlternative>& alternatives, bool residual) {
+  py::list out;
+  for (const auto& a : alternatives) {
     py::dict alt;
     alt["angle_deg"] = tidy(a.angle_deg);
     alt["axis"] = py::make_tuple(tidy(a.axis.x()), tidy(a.axis.y()), tidy(a.axis.z()));
     alt["depth_fit"] = tidy(a.depth_fit);
+    if (residual) alt["depth_residual_mm"] = tidy(1e3f * a.depth_residual_m);
     alt["colour"] = tidy(a.colour);
     alt["score"] = tidy(a.score);
-    alternatives.append(alt);
+    out.append(alt);
   }
+  return out;
+}
+
+/// The near-symmetric poses compared: {"alternatives", "chosen": index, "margin": by how much
+/// it won, "compared"}.
+py::dict symmetryDict(const Detection& d) {
   py::dict out;
-  out["alternatives"] = alternatives;
+  out["alternatives"] = alternativesList(d.symmetry_alternatives, false);
   out["chosen"] = d.symmetry_chosen;
   out["margin"] = tidy(d.symmetry_margin);
   out["compared"] = d.symmetry_compared;
+  return out;
+}
+
+/// The look-alike half-turns refit and compared: {"alternatives", "chosen", "margin"}.
+py::object lookAlikeDict(const Detection& d) {
+  if (d.look_alike_alternatives.empty()) return py::none();
+  py::dict out;
+  out["alternatives"] = alternativesList(d.look_alike_alternatives, true);
+  out["chosen"] = d.look_alike_chosen;
+  out["margin"] = tidy(d.look_alike_margin);
   return out;
 }
 
@@ -174,6 +191,7 @@ py::dict detectionDict(const Detection& d) {
     out["symmetry"] = symmetryDict(d);
     out["ambiguous_symmetry"] = d.ambiguous_symmetry;
   }
+  if (!d.look_alike_alternatives.empty()) out["look_alike_turns"] = lookAlikeDict(d);
   if (!d.rejection.empty()) out["reason"] = d.rejection;
   return out;
 }
@@ -363,6 +381,8 @@ leaves the config as it was.)")
           "The near-symmetric poses compared with the scene and the one kept (None when the object has none)")
       .def_property_readonly("ambiguous_symmetry", [](const PyDetection& p) { return p.d.ambiguous_symmetry; },
                              "Colour and depth could not tell the near-symmetric poses apart")
+      .def_property_readonly("look_alike_turns", [](const PyDetection& p) { return lookAlikeDict(p.d); },
+                             "The look-alike half-turns refit and compared with the pose (None when none were)")
       .def_property_readonly("reason", [](const PyDetection& p) { return p.d.rejection; },
                              "Why it was rejected (rejected hypotheses only; empty otherwise)")
       .def("to_dict", [](const PyDetection& p) { return detectionDict(p.d); }, "Every field as a dict")

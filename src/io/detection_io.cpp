@@ -27,6 +27,22 @@ double round(double v, int decimals) {
   return std::round(v * s) / s;
 }
 
+/// Poses compared with a detection's: angle, axis, depth fit, colour, score (and the depth
+/// residual in mm where it counted).
+nlohmann::ordered_json alternativesJson(const std::vector<SymmetryAlternative>& alternatives, bool residual) {
+  auto out = nlohmann::ordered_json::array();
+  for (const auto& a : alternatives) {
+    nlohmann::ordered_json alt = {{"angle_deg", round(a.angle_deg, 1)},
+                                  {"axis", {round(a.axis.x(), 4), round(a.axis.y(), 4), round(a.axis.z(), 4)}},
+                                  {"depth_fit", round(a.depth_fit, 4)}};
+    if (residual) alt["depth_residual_mm"] = round(1e3 * a.depth_residual_m, 2);
+    alt["colour"] = round(a.colour, 4);
+    alt["score"] = round(a.score, 4);
+    out.push_back(std::move(alt));
+  }
+  return out;
+}
+
 void refuseOverwrite(const std::string& path, bool overwrite) {
   if (!overwrite && std::filesystem::exists(path))
     throw InputError(path + " exists; pass --force to overwrite it");
@@ -70,19 +86,17 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
   j["similarity"] = round(d.similarity, 2);
   if (!d.symmetry_alternatives.empty()) {
     // Which near-symmetric poses were compared and by how much the kept one won.
-    auto alternatives = nlohmann::ordered_json::array();
-    for (const auto& a : d.symmetry_alternatives)
-      alternatives.push_back({{"angle_deg", round(a.angle_deg, 1)},
-                              {"axis", {round(a.axis.x(), 4), round(a.axis.y(), 4), round(a.axis.z(), 4)}},
-                              {"depth_fit", round(a.depth_fit, 4)},
-                              {"colour", round(a.colour, 4)},
-                              {"score", round(a.score, 4)}});
-    j["symmetry"] = {{"alternatives", std::move(alternatives)},
+    j["symmetry"] = {{"alternatives", alternativesJson(d.symmetry_alternatives, false)},
                      {"chosen", d.symmetry_chosen},
                      {"margin", round(d.symmetry_margin, 4)},
                      {"compared", d.symmetry_compared}};
     j["ambiguous_symmetry"] = d.ambiguous_symmetry;
   }
+  if (!d.look_alike_alternatives.empty())
+    // The look-alike half-turns refit and compared (the kept pose first), and the margin.
+    j["look_alike_turns"] = {{"alternatives", alternativesJson(d.look_alike_alternatives, true)},
+                             {"chosen", d.look_alike_chosen},
+                             {"margin", round(d.look_alike_margin, 4)}};
   if (!d.rejection.empty()) j["reason"] = d.rejection;
   return j;
 }

@@ -93,6 +93,19 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
     for (const auto& v : banks_[b].mesh.vertices)
       bounding_radius_[b] = std::max(bounding_radius_[b], (v - banks_[b].centre).norm());
   for (const auto& b : banks_) colourful_.push_back(meshChromaSpread(b.mesh) >= kMinChromaSpread);
+  // Look-alike half-turns: about 0.1 s a mesh, so found here rather than stored (banks of
+  // every version get them, and the tolerance stays a detection setting).
+  look_alike_turns_.assign(banks_.size(), {});
+  if (params_.verify.resolve_symmetries && params_.verify.look_alike_tolerance > 0.f)
+    util::parallelFor(
+        banks_.size(),
+        [&](std::size_t b) {
+          const TemplateBank& bank = banks_[b];
+          if (bank.symmetric) return;  // scored with ADI: turns do not count against it
+          const float from = std::max(bank.params.near_symmetry_tolerance, 0.01f) * bank.diameter;
+          look_alike_turns_[b] = findLookAlikeTurns(bank.mesh, from, params_.verify.look_alike_tolerance * bank.diameter);
+        },
+        params_.threads);
 }
 
 Detector::~Detector() = default;
@@ -419,6 +432,97 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const Sc
     const auto start = std::chrono::steady_clock::now();
     refined[i] = refinePose(initial[i].model_points, smoothed[i], poses[chosen], icp_params);
     cpu_ms[i] += msSince(start);
+    verifyCandidate(i);
+  }
+  // Look-alike half-turns (a carton end for end, a jug flank for flank): the templates look
+  // alike, so stage 6 may settle on either, and the turn is a centimetre off, so ICP cannot
+  // walk from one to the other. Each accepted pose is turned, refit from there, and the two
+  // are rendered and compared: colour where it counts, and the depth residual over the whole
+  // mask (both fit within the see-through tolerance; the wrong one sits further off).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto b = static_cast<std::size_t>(hypotheses[i].bank);
+    const auto& turns = look_alike_turns_[b];
+    if (turns.empty() || !initial[i].ok || !verified[i].accepted) continue;
+    const auto windowOf = [&](const std::vector<Pose>& poses) {
+      cv::Rect window;
+      for (const auto& p : poses) window |= projectedWindow(p, banks_[b].centre, bounding_radius_[b], camera);
+      return window;
+    };
+    std::vector<Pose> starts;
+    for (const auto& h : turns) starts.push_back(compose(refined[i].pose, h.transform()));
+    const cv::Rect start_window = windowOf(starts);
+    if (start_window.empty()) continue;
+    const auto start_views = renderers_[b]->render(windowCamera(camera, start_window), starts);
+    RefineParams icp_params = refine_params[i];
+    icp_params.mls = false;
+    std::vector<RefineResult> refits(turns.size());
+    const auto start = std::chrono::steady_clock::now();
+    util::parallelFor(
+        turns.size(),
+        [&](std::size_t k) {
+          refits[k] = refinePose(visibleModelPoints(start_views[k], starts[k], camera, start_window), smoothed[i],
+                                 starts[k], icp_params);
+        },
+        params_.threads);
+    cpu_ms[i] += msSince(start);
+    // Each refit with the near-symmetries' turns too where colour can tell them (a carton
+    // end for end shows another painted face on top): pose 0 is the kept one, then per
+    // look-alike turn its refit composed with each near-symmetry.
+    const bool compose_turns = colourful_[b] && params_.verify.resolve_symmetries;
+    const auto& symmetries = banks_[b].near_symmetries;
+    const std::size_t family = 1 + (compose_turns ? symmetries.size() : 0);
+    std::vector<Pose> poses{refined[i].pose};
+    for (const auto& r : refits) {
+      poses.push_back(r.pose);
+      if (compose_turns)
+        for (const auto& sym : symmetries) poses.push_back(compose(r.pose, sym.transform()));
+    }
+    const cv::Rect window = windowOf(poses);
+    if (window.empty()) continue;
+    const auto views = renderers_[b]->render(windowCamera(camera, window), poses);
+    const float tolerance = verify_params[i].see_through_tolerance;
+    std::vector<SymmetryAlternative> alts(1 + turns.size());
+    std::vector<std::size_t> member(alts.size(), 0);  // the pose (index into poses) each alternative stands for
+    bool informative = false;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const AppearanceAgreement a =
+          appearanceAgreement(views[k], window, scene_bgr, scene.depth_m, tolerance, colourful_[b]);
+      SymmetryAlternative alt;
+      const std::size_t g = k == 0 ? 0 : 1 + (k - 1) / family;  // 0: the kept pose, g: turns[g - 1]
+      if (g > 0) alt.angle_deg = turns[g - 1].angle_deg, alt.axis = turns[g - 1].axis;
+      alt.depth_fit = a.depth_fit;
+      alt.colour = a.colour;
+      alt.depth_residual_m = a.depth_residual_m;
+      alt.score = a.score * std::max(0.f, 1.f - a.depth_residual_m / std::max(tolerance, 1e-6f));
+      informative = informative || a.colour_informative;
+      if (k == 0 || k == 1 + (g - 1) * family || alt.score > alts[g].score) alts[g] = alt, member[g] = k;
+    }
+    const auto best = static_cast<std::size_t>(
+        std::max_element(alts.begin(), alts.end(), [](const auto& x, const auto& y) { return x.score < y.score; }) -
+        alts.begin());
+    float rival = -1.f;
+    for (std::size_t k = 0; k < alts.size(); ++k)
+      if (k != best) rival = std::max(rival, alts[k].score);
+    const float margin = params_.verify.symmetry_margin;
+    const std::size_t chosen = best != 0 && alts[best].score >= alts[0].score + margin ? best : 0;
+    Detection& d = dets[i];
+    d.look_alike_chosen = static_cast<int>(chosen);
+    d.look_alike_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
+    if (chosen != 0 && informative) d.colour_agreement = alts[chosen].colour;
+    d.look_alike_alternatives = std::move(alts);
+    if (chosen == 0) continue;
+    // Verified as any pose is, from the model surface its own rendering shows; a composed
+    // near-symmetry is a few millimetres off, so the fine fit runs once more from there.
+    const std::size_t k = member[chosen];
+    initial[i].model_points = visibleModelPoints(views[k], poses[k], camera, window);
+    if (k == 1 + (chosen - 1) * family) {
+      refined[i] = refits[chosen - 1];
+    } else {
+      icp_params.coarse_iterations = 0;
+      const auto again = std::chrono::steady_clock::now();
+      refined[i] = refinePose(initial[i].model_points, smoothed[i], poses[k], icp_params);
+      cpu_ms[i] += msSince(again);
+    }
     verifyCandidate(i);
   }
   const double symmetries_ms = msSince(symmetries0);

@@ -85,6 +85,9 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
   if (!(params.symmetry_margin >= 0.f && params.symmetry_margin <= 1.f))
     throw InputError(fmt::format("the symmetry margin must be in [0, 1], got {}", params.symmetry_margin));
+  if (!(params.look_alike_tolerance >= 0.f && params.look_alike_tolerance <= 0.5f))
+    throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}",
+                                 params.look_alike_tolerance));
   if (!(params.min_colour_agreement >= -1.f && params.min_colour_agreement <= 1.f))
     throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", params.min_colour_agreement));
 }

@@ -46,6 +46,7 @@ AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Re
     throw InputError("appearanceAgreement: the rendering is not the window's size");
   AppearanceAgreement out;
   int fits = 0;
+  double residual = 0;
   // Sums for the correlation of the 2-vectors (r, g) rendered against seen.
   double n = 0, sa_r = 0, sa_g = 0, sb_r = 0, sb_g = 0, saa = 0, sbb = 0, sab = 0;
   for (int y = 0; y < window.height; ++y) {
@@ -57,6 +58,7 @@ AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Re
       const float rz = rendering.depth.at<float>(y, x), sz = scene_depth_m.at<float>(sy, sx);
       if (rz <= 0.f || sz <= 0.f || sz < rz - depth_tolerance) continue;  // not the object, no depth, hidden
       ++out.pixels;
+      residual += std::min(std::abs(sz - rz), depth_tolerance);
       if (sz > rz + depth_tolerance) continue;  // seen through
       ++fits;
       double ar, ag, br, bg;
@@ -69,6 +71,7 @@ AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Re
   }
   if (out.pixels == 0) return out;
   out.depth_fit = static_cast<float>(fits) / static_cast<float>(out.pixels);
+  out.depth_residual_m = static_cast<float>(residual / out.pixels);
   out.score = out.depth_fit;
   if (!colour_counts || n < kMinColourPixels) return out;
   const double var_a = saa / n - (sa_r * sa_r + sa_g * sa_g) / (n * n);

@@ -11,6 +11,10 @@ namespace vkpose {
 struct AppearanceAgreement {
   int pixels = 0;          ///< rendered pixels with scene depth that nothing in front hides
   float depth_fit = 0.f;   ///< share of them within the tolerance of the scene's depth
+  /// Mean |scene - rendered| depth over them, each capped at the tolerance (metres): the
+  /// whole mask's residual, which tells a pose from a look-alike turn a centimetre off where
+  /// both fit within the tolerance.
+  float depth_residual_m = 0.f;
   /// Concordance (-1..1) of the rendered and the scene's chromaticity (r, g of r+g+b: blind to
   /// shading and brightness) over the fitting pixels that are bright enough to have one:
   /// 2 cov / (var_rendered + var_seen + w |mean difference|^2), w = 1 where the rendering is of

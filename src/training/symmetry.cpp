@@ -107,9 +107,14 @@ std::string describe(const NearSymmetry& s) {
                      1e3f * s.point.z(), 1e3f * s.deviation_m);
 }
 
-std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count) {
+namespace {
+
+/// Turns by `angles` about the principal and model axes whose deviation lies in
+/// (from_m, to_m], the closer of two that are one turn, sorted by deviation.
+std::vector<NearSymmetry> findTurns(const Mesh& mesh, const std::vector<float>& angles, float from_m, float to_m,
+                                    int max_count) {
   std::vector<NearSymmetry> found;
-  if (tolerance_m <= 0.f || mesh.faces.empty() || max_count <= 0) return found;
+  if (to_m <= 0.f || to_m <= from_m || mesh.faces.empty() || max_count <= 0) return found;
   const PointCloud a = sampleSurface(mesh, kSamples, 1u), b = sampleSurface(mesh, kSamples, 2u);
   if (a.empty()) return found;
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
@@ -127,23 +132,23 @@ std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m
 
   // Distances are searched up to the tolerance plus a few sampling spacings (the floor).
   const float spacing = mesh.diameter / std::sqrt(static_cast<float>(kSamples));
-  CappedDistance distance(b, tolerance_m + 4.f * spacing);
+  CappedDistance distance(b, to_m + 4.f * spacing);
   const float floor = distance.quantile(a, Pose{}, kQuantile, 1e9f);
 
   for (const auto& [axis, point] : axes) {
-    for (const float angle : kAngles) {
+    for (const float angle : angles) {
       NearSymmetry s;
       s.axis = axis;
       s.point = point;
       s.angle_deg = angle;
-      s.deviation_m = std::max(0.f, distance.quantile(a, s.transform(), kQuantile, tolerance_m + floor) - floor);
-      if (s.deviation_m > tolerance_m) continue;
+      s.deviation_m = std::max(0.f, distance.quantile(a, s.transform(), kQuantile, to_m + floor) - floor);
+      if (s.deviation_m > to_m) continue;
       // The same turn found twice (a principal axis near a model axis): keep the closer fit.
       const Pose t = s.transform();
       const Eigen::Vector3f c = mesh.bboxCentre();
       const auto same = std::find_if(found.begin(), found.end(), [&](const NearSymmetry& o) {
         const Pose u = o.transform();
-        return (t.R - u.R).norm() < 0.25f && ((t.R * c + t.t) - (u.R * c + u.t)).norm() < tolerance_m;
+        return (t.R - u.R).norm() < 0.25f && ((t.R * c + t.t) - (u.R * c + u.t)).norm() < to_m;
       });
       if (same == found.end())
         found.push_back(s);
@@ -151,10 +156,23 @@ std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m
         *same = s;
     }
   }
+  // Dropped only now: a turn within from_m may have been the closer twin of one beyond it.
+  found.erase(std::remove_if(found.begin(), found.end(), [&](const NearSymmetry& s) { return s.deviation_m <= from_m; }),
+              found.end());
   std::stable_sort(found.begin(), found.end(),
                    [](const NearSymmetry& x, const NearSymmetry& y) { return x.deviation_m < y.deviation_m; });
   if (found.size() > static_cast<std::size_t>(max_count)) found.resize(static_cast<std::size_t>(max_count));
   return found;
+}
+
+}  // namespace
+
+std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count) {
+  return findTurns(mesh, {kAngles.begin(), kAngles.end()}, -1.f, tolerance_m, max_count);
+}
+
+std::vector<NearSymmetry> findLookAlikeTurns(const Mesh& mesh, float from_m, float to_m, int max_count) {
+  return findTurns(mesh, {180.f}, std::max(0.f, from_m), to_m, max_count);
 }
 
 }  // namespace vkpose
