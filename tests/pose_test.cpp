@@ -101,6 +101,45 @@ TEST(InitialRotation, TakesTheLargestGroupAndTurnsItOntoTheViewingRay) {
   }
 }
 
+// A cluster that mixes look-alike views: the largest rotation group (three templates) fits the
+// scene's depth worse than a group of two, which becomes a second start.
+TEST(InitialRotation, StartsAlsoFromTheGroupThatFitsTheSceneBest) {
+  const Eigen::Vector3f x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  const TemplateBank bank = rotationBank({rot(3, z), rot(70, x), rot(-3, z), rot(0, y), rot(72, x)});
+  const Camera camera;
+  Hypothesis h;
+  h.x = static_cast<float>(camera.cx);
+  h.y = static_cast<float>(camera.cy);
+  h.distance = 0.7f;
+  for (int i = 0; i < 5; ++i) h.members.push_back({i, 0, 0, 90.f - float(i), h.x, h.y});
+  const auto scored = [&](float largest_error, float other_error) {
+    h.member_scores.assign(5, {});
+    for (int i = 0; i < 5; ++i) {
+      MemberScore& s = h.member_scores[static_cast<std::size_t>(i)];
+      s.object_cells = 100, s.depth_pairs = 90, s.normal_pairs = 80;
+      s.depth_error = i == 1 || i == 4 ? other_error : largest_error;
+      s.angle_error = 0.1f;
+    }
+  };
+  scored(0.02f, 0.001f);
+  InitialRotation r = initialRotation(h, bank, camera);
+  EXPECT_EQ(r.group_size, 3);
+  EXPECT_LT(rotationDistance(r.R, Eigen::Matrix3f::Identity()) / kDeg, 0.5f);
+  ASSERT_TRUE(r.by_fit.has_value());
+  EXPECT_EQ(r.by_fit_size, 2);
+  EXPECT_LT(rotationDistance(*r.by_fit, rot(71, x)) / kDeg, 0.5f);
+  // Off: one start.
+  InitialPoseParams one;
+  one.second_start_by_fit = false;
+  EXPECT_FALSE(initialRotation(h, bank, camera, one).by_fit.has_value());
+  // The largest group fits best too: one start.
+  scored(0.001f, 0.02f);
+  EXPECT_FALSE(initialRotation(h, bank, camera).by_fit.has_value());
+  // Without stage 4's scores (estimate_poses off, or scored elsewhere): one start.
+  h.member_scores.clear();
+  EXPECT_FALSE(initialRotation(h, bank, camera).by_fit.has_value());
+}
+
 /// The scene: a box on a wall at 0.8 m; the hypothesis: the same box rendered `offset` away.
 struct TranslationCase {
   Camera camera;

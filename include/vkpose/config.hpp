@@ -61,6 +61,12 @@ struct InitialPoseParams {
   /// tau_theta: template rotations closer than this (axis-angle distance to a group's mean,
   /// degrees) vote for the same rotation (the paper: 10 degrees).
   float rotation_cluster_deg = 10.f;
+  /// A second start per hypothesis: the rotation group whose members fit the scene's depth
+  /// and normals best (stage 4's member scores, summed), where it is not the largest group.
+  /// A cluster that mixes look-alike views (a jug lying on either flank, banks trained
+  /// --resting all) holds groups of two or three templates, and the largest is often the
+  /// wrong one. Both starts are refined and verified; the better survives.
+  bool second_start_by_fit = true;
   /// A scene pixel under the rendered mask belongs to the object when its depth lies within
   /// this fraction of the object's diameter of the rendered depth there. Nearer is an
   /// occluder, farther is what lies behind the object (the mask is still misplaced by up to a

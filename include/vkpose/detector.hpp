@@ -143,7 +143,7 @@ class Detector {
   const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running
 
   DetectionResult detectFrame(const LinemodFrame& frame, const Camera& camera, const LinemodFrame* next);
-  void estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene, const cv::Mat& frame_bgr,
+  void estimatePoses(const std::vector<Hypothesis>& clusters, const ScoreScene& scene, const cv::Mat& frame_bgr,
                      DetectionResult& result);
 };
 

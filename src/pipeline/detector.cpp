@@ -238,26 +238,33 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   return result;
 }
 
-void Detector::estimatePoses(const std::vector<Hypothesis>& hypotheses, const ScoreScene& scene,
+void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const ScoreScene& scene,
                              const cv::Mat& frame_bgr, DetectionResult& result) {
   // Colour for the near-symmetries' check; a frame without it (depth only) compares depth.
   const cv::Mat scene_bgr = frame_bgr.type() == CV_8UC3 && frame_bgr.size() == scene.depth_m.size()
                                 ? frame_bgr
                                 : cv::Mat(scene.depth_m.size(), CV_8UC3, cv::Scalar::all(0));
   const Camera& camera = scene.camera;
-  const std::size_t n = hypotheses.size();
-  // Stage 6: rotations, then one render call per bank, then the translations in parallel.
+  // Stage 6: rotations (one or two starts a hypothesis: second_start_by_fit), then one render
+  // call per bank, then the translations in parallel. From here on a candidate is a start.
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<Detection> dets(n);
-  std::vector<Pose> rendered(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Hypothesis& h = hypotheses[i];
+  std::vector<Hypothesis> hypotheses;
+  std::vector<Detection> dets;
+  std::vector<Pose> rendered;
+  for (const Hypothesis& h : clusters) {
     const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
     const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose);
-    dets[i] = hypothesisDetection(h, banks_);
-    dets[i].rotation_votes = rot.group_size;
-    rendered[i] = poseOnViewingRay(rot.R, h, bank, camera);
+    hypotheses.push_back(h);
+    dets.push_back(hypothesisDetection(h, banks_));
+    dets.back().rotation_votes = rot.group_size;
+    rendered.push_back(poseOnViewingRay(rot.R, h, bank, camera));
+    if (!rot.by_fit) continue;
+    hypotheses.push_back(h);
+    dets.push_back(hypothesisDetection(h, banks_));
+    dets.back().rotation_votes = rot.by_fit_size;
+    rendered.push_back(poseOnViewingRay(*rot.by_fit, h, bank, camera));
   }
+  const std::size_t n = hypotheses.size();
   if (renderers_.empty()) {
     // One workspace for all banks: they render one after another, and each renderer with its
     // own held up to about 170 MiB of full-frame outputs and staging (1.3 GiB for 8 objects).

@@ -6,6 +6,7 @@
 // of its own rendered points. Rendering is the caller's (MeshRenderer): these functions are
 // plain data in, plain data out.
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,12 +48,17 @@ struct InitialRotation {
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera
   int group_size = 0;  ///< templates in the chosen group
   int candidates = 0;  ///< templates of the hypothesis
+  /// InitialPoseParams::second_start_by_fit: the mean of the group whose members' stage-4 fit
+  /// sums highest, when that is not the largest group (farther than tau_theta from R).
+  std::optional<Eigen::Matrix3f> by_fit;
+  int by_fit_size = 0;  ///< templates in that group
 };
 
 /// Stage 6, rotation: every member's template rotation is turned onto the viewing ray through
 /// the object centre it was matched at (off the image centre the same view appears rotated:
 /// about 30 degrees at the corners of a 640x480 Kinect image); the rotations are clustered at
 /// tau_theta, best similarity first, and the largest group's mean is the initial rotation.
+/// The members that stage 4 scored vote again, each by its fit to the scene (by_fit).
 InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
                                 const InitialPoseParams& params = {});
 
