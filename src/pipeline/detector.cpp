@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -73,6 +74,21 @@ void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vec
     d.y = uv.y();
   }
 }
+
+/// Of a pose (alternatives[0]) and its alternatives, the one kept: the pose stays unless the
+/// best alternative scores `margin` higher. Also by how much the kept one beat the best other.
+std::pair<std::size_t, float> chooseAlternative(const std::vector<SymmetryAlternative>& alternatives, float margin) {
+  const auto best = static_cast<std::size_t>(
+      std::max_element(alternatives.begin(), alternatives.end(),
+                       [](const auto& x, const auto& y) { return x.score < y.score; }) -
+      alternatives.begin());
+  float rival = -1.f;
+  for (std::size_t k = 0; k < alternatives.size(); ++k)
+    if (k != best) rival = std::max(rival, alternatives[k].score);
+  const std::size_t chosen = best != 0 && alternatives[best].score >= alternatives[0].score + margin ? best : 0;
+  return {chosen, alternatives[chosen].score - (chosen == best ? rival : alternatives[best].score)};
+}
+
 }  // namespace
 
 Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorParams params)
@@ -413,20 +429,13 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
       alts.push_back(alt);
       informative = informative || a.colour_informative;
     }
-    const auto best = static_cast<std::size_t>(
-        std::max_element(alts.begin(), alts.end(), [](const auto& x, const auto& y) { return x.score < y.score; }) -
-        alts.begin());
-    float rival = -1.f;
-    for (std::size_t k = 0; k < alts.size(); ++k)
-      if (k != best) rival = std::max(rival, alts[k].score);
     const float margin = params_.verify.symmetry_margin;
-    // ICP's pose stays unless an alternative beats it by the margin.
-    const std::size_t chosen = best != 0 && alts[best].score >= alts[0].score + margin ? best : 0;
+    const auto [chosen, won_by] = chooseAlternative(alts, margin);
     Detection& d = dets[i];
     if (informative) d.colour_agreement = alts[chosen].colour;
     if (turns) {
       d.symmetry_chosen = static_cast<int>(chosen);
-      d.symmetry_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
+      d.symmetry_margin = won_by;
       d.ambiguous_symmetry = d.symmetry_margin < margin;
       d.symmetry_alternatives = std::move(alts);
     }
@@ -504,17 +513,10 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
       informative = informative || a.colour_informative;
       if (k == 0 || k == 1 + (g - 1) * family || alt.score > alts[g].score) alts[g] = alt, member[g] = k;
     }
-    const auto best = static_cast<std::size_t>(
-        std::max_element(alts.begin(), alts.end(), [](const auto& x, const auto& y) { return x.score < y.score; }) -
-        alts.begin());
-    float rival = -1.f;
-    for (std::size_t k = 0; k < alts.size(); ++k)
-      if (k != best) rival = std::max(rival, alts[k].score);
-    const float margin = params_.verify.symmetry_margin;
-    const std::size_t chosen = best != 0 && alts[best].score >= alts[0].score + margin ? best : 0;
+    const auto [chosen, won_by] = chooseAlternative(alts, params_.verify.symmetry_margin);
     Detection& d = dets[i];
     d.look_alike_chosen = static_cast<int>(chosen);
-    d.look_alike_margin = alts[chosen].score - (chosen == best ? rival : alts[best].score);
+    d.look_alike_margin = won_by;
     if (chosen != 0 && informative) d.colour_agreement = alts[chosen].colour;
     d.look_alike_alternatives = std::move(alts);
     if (chosen == 0) continue;
