@@ -18,6 +18,10 @@ ScoreScene makeScoreScene(const cv::Mat& depth_mm, const Camera& camera) {
   return s;
 }
 
+float MemberScore::fit(const ScoreParams& params) const {
+  return std::exp(-depth_error / params.depth_unit_m) * std::exp(-angle_error / params.angle_unit_rad);
+}
+
 void scoreMembersReference(std::vector<Hypothesis>& hypotheses, const std::vector<TemplateBank>& banks,
                            const ScoreScene& scene, const ScoreParams& params) {
   validateScoreParams(params);
@@ -44,7 +48,7 @@ void combineMemberScores(std::vector<Hypothesis>& hypotheses, const ScoreParams&
       if (s.object_cells == 0 || s.normal_pairs == 0 ||
           static_cast<float>(s.depth_pairs) < params.min_valid_fraction * static_cast<float>(s.object_cells))
         continue;
-      ranked.push_back({std::exp(-s.depth_error / params.depth_unit_m) * std::exp(-s.angle_error / params.angle_unit_rad), m});
+      ranked.push_back({s.fit(params), m});
     }
     // Best fit first; ties by member order (best similarity first), so the result is stable.
     std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) { return a.own > b.own; });

@@ -43,6 +43,10 @@ struct MemberScore {
   float depth_offset = 0.f;    ///< mean scene - template depth over the pairs, metres
   float depth_error = 0.f;     ///< mean |difference - offset|, truncated, metres
   float angle_error = 0.f;     ///< mean angle between template and scene normals, radians
+
+  /// The member's own alpha * beta: how well its template alone fits the scene's depth and
+  /// normals (stage 4 ranks members by it; stage 6 weighs their rotation votes by it).
+  float fit(const ScoreParams& params) const;
 };
 
 /// One object instance candidate.

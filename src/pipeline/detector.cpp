@@ -269,7 +269,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   std::vector<Pose> rendered;
   for (const Hypothesis& h : clusters) {
     const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
-    const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose);
+    const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose, params_.score);
     hypotheses.push_back(h);
     dets.push_back(hypothesisDetection(h, banks_));
     dets.back().rotation_votes = rot.group_size;

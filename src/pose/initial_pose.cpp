@@ -70,7 +70,7 @@ std::vector<RotationGroup> clusterRotations(const std::vector<Eigen::Matrix3f>& 
 }
 
 InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
-                                const InitialPoseParams& params) {
+                                const InitialPoseParams& params, const ScoreParams& score) {
   std::vector<Eigen::Matrix3f> rotations;
   std::vector<float> weights;
   for (const ClusterMember& m : h.members) {  // best similarity first
@@ -86,15 +86,15 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
   out.R = groups.front().mean;
   out.group_size = static_cast<int>(groups.front().members.size());
   if (!params.second_start_by_fit) return out;
-  // The scored members again, each weighted by its fit (stage 4's own score at its default
-  // units: 1 cm of depth error, half a radian of normals), groups ranked by the sum.
+  // The scored members again, each weighted by its own fit to the scene (stage 4's), groups
+  // ranked by the sum.
   std::vector<Eigen::Matrix3f> fitted;
   std::vector<float> fits;
   for (std::size_t k = 0; k < std::min(h.members.size(), h.member_scores.size()); ++k) {
     const MemberScore& s = h.member_scores[k];
     if (s.object_cells == 0 || s.normal_pairs == 0) continue;
     fitted.push_back(rotations[k]);
-    fits.push_back(std::exp(-s.depth_error / 0.01f) * std::exp(-s.angle_error / 0.5f));
+    fits.push_back(s.fit(score));
   }
   if (fitted.empty()) return out;
   const float tau = params.rotation_cluster_deg * static_cast<float>(M_PI) / 180.f;

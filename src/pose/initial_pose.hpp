@@ -58,9 +58,10 @@ struct InitialRotation {
 /// the object centre it was matched at (off the image centre the same view appears rotated:
 /// about 30 degrees at the corners of a 640x480 Kinect image); the rotations are clustered at
 /// tau_theta, best similarity first, and the largest group's mean is the initial rotation.
-/// The members that stage 4 scored vote again, each by its fit to the scene (by_fit).
+/// The members that stage 4 scored vote again, each by its fit to the scene at `score`'s units
+/// (MemberScore::fit), for by_fit.
 InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
-                                const InitialPoseParams& params = {});
+                                const InitialPoseParams& params = {}, const ScoreParams& score = {});
 
 /// A pose with rotation R whose object centre `centre` (object frame) lies on the viewing ray
 /// through pixel (x, y), `range` metres from the camera.
