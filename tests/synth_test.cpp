@@ -1,6 +1,7 @@
 // `vkpose synth`: reproducible bytes, a BOP dataset the reader loads with boxes that match the
 // poses, placements that never intersect and rest on the table or in the bin, Tejani poses
 // taken verbatim, and clear errors for bad input.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -12,6 +13,8 @@
 
 #include "mesh_support.hpp"
 #include "synth/placement.hpp"
+#include "synth/scene.hpp"
+#include "vkpose/bank.hpp"
 #include "test_support.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
@@ -221,6 +224,46 @@ TEST(SynthPlacement, RestingOrientationsAreStable) {
   const auto rest = restingOrientations(l);
   EXPECT_LT(rest.size(), 6u);
   for (const auto& r : rest) EXPECT_NEAR(lowestZ(l, {r.R, Eigen::Vector3f(0.f, 0.f, r.lift_m)}), 0.f, 1e-5f);
+}
+
+TEST(SynthPlacement, ObjectsRestOnlyWhereTrainingSaysTheyStand) {
+  // A scene must hold the poses a bank trained with --resting all covers, no others: synth
+  // once let the milk jug balance on its cap (+z up), which training rejects as a base.
+  VKPOSE_REQUIRE_SHARED_DATA();
+  for (const char* name : {"milk.stl", "juicecarton.stl", "coffee_cup.stl"}) {
+    const Mesh mesh = loadMesh(test::sharedData() + "/meshes/" + name, MeshUnits::Metres);
+    const UpAxisChoice choice = findUpAxis(mesh);
+    std::vector<Eigen::Vector3f> stands;
+    for (const RestingCandidate& c : choice.candidates)
+      if (c.stands()) stands.push_back(c.up);
+    const auto rest = restingOrientations(mesh);
+    ASSERT_EQ(rest.size(), stands.size()) << name;
+    for (std::size_t i = 0; i < rest.size(); ++i) {
+      // The object's up in the world is +z: R maps some standing candidate's up there.
+      const Eigen::Vector3f up = rest[i].R.transpose() * Eigen::Vector3f::UnitZ();
+      EXPECT_TRUE(std::any_of(stands.begin(), stands.end(), [&](const Eigen::Vector3f& s) { return s.dot(up) > 0.999f; }))
+          << name << " rests with " << upAxisName(up) << " up";
+    }
+  }
+  const auto milk = restingOrientations(loadMesh(test::sharedData() + "/meshes/milk.stl", MeshUnits::Metres));
+  for (const auto& r : milk) EXPECT_LT((r.R.transpose() * Eigen::Vector3f::UnitZ()).z(), 0.999f) << "the jug on its cap";
+}
+
+TEST(SynthScene, AnObjectTheBorderCutsInHalfIsHalfVisible) {
+  // BOP's px_count_all counts what the border cuts off (calc_gt_info renders three times the
+  // image): a box on the optical axis of a camera whose principal point is on the left edge is
+  // cut in half (its silhouette is symmetric about the axis), one to its right is whole.
+  const Mesh box = test::boxMesh({0.1f, 0.1f, 0.1f});
+  Camera camera;
+  camera.cx = 0.0;
+  std::vector<SceneObject> objects(2);
+  objects[0].mesh = objects[1].mesh = &box;
+  objects[0].pose.t = Eigen::Vector3f(0.f, 0.f, 0.8f);
+  objects[1].pose.t = Eigen::Vector3f(0.3f, 0.f, 0.8f);
+  const SceneRendering r = renderScene(test::context(), objects, camera);
+  EXPECT_NEAR(r.visibleFraction(0), 0.5f, 0.03f);
+  EXPECT_GT(r.full_pixels[0], cv::countNonZero(r.full_masks[0]));
+  EXPECT_FLOAT_EQ(r.visibleFraction(1), 1.f);
 }
 
 TEST(SynthTejani, PosesAreUsedVerbatim) {

@@ -38,16 +38,16 @@ OrientedBox orientedBox(const Mesh& mesh, const Pose& world_T_object);
 /// axis count as intersecting.
 bool boxesIntersect(const OrientedBox& a, const OrientedBox& b, float gap_m = 0.f);
 
-/// A way the object rests on a table: a face of its bounding box down, checked for stability
-/// (the centroid above the hull of the points that touch the table).
+/// A way the object rests on a table: one of the six axis directions down, where training's
+/// resting test says the object stands on it (findUpAxis, RestingCandidate::stands).
 struct RestingOrientation {
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-world rotation, no yaw
   float lift_m = 0.f;  ///< translation along z that puts its lowest point on the table
   float weight = 0.f;  ///< relative chance: 1 / centroid height (low and stable is likely)
 };
 
-/// The stable resting orientations among the six bounding-box faces down (all six, weight 1,
-/// for a mesh none of whose faces is stable).
+/// The stable resting orientations among the six axis directions down: the ones a bank
+/// trained with --resting all covers (all six, weight 1, for a mesh that stands on none).
 std::vector<RestingOrientation> restingOrientations(const Mesh& mesh);
 
 /// camera_T_world of a camera `height_m` above the table whose optical axis passes through

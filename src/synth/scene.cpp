@@ -14,6 +14,16 @@
 
 namespace vkpose {
 
+namespace {
+
+bool touchesBorder(const cv::Mat& mask) {
+  const int w = mask.cols, h = mask.rows;
+  return cv::countNonZero(mask.row(0)) > 0 || cv::countNonZero(mask.row(h - 1)) > 0 ||
+         cv::countNonZero(mask.col(0)) > 0 || cv::countNonZero(mask.col(w - 1)) > 0;
+}
+
+}  // namespace
+
 SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>& objects, const Camera& camera) {
   validateCamera(camera);
   const cv::Size size(camera.width, camera.height);
@@ -44,11 +54,13 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
     std::vector<Pose> poses;
     for (std::size_t i : indices) poses.push_back(objects[i].pose);
     const std::vector<Rendering> views = renderer.render(camera, poses);
+    std::vector<std::size_t> cut_off;  // objects the image's border cuts
     for (std::size_t k = 0; k < indices.size(); ++k) {
       const Rendering& r = views[k];
       const auto label = static_cast<uint16_t>(indices[k] + 1);
       out.full_masks[indices[k]] = r.mask();
       out.full_pixels[indices[k]] = cv::countNonZero(out.full_masks[indices[k]]);
+      if (touchesBorder(out.full_masks[indices[k]])) cut_off.push_back(indices[k]);
       for (int y = 0; y < size.height; ++y)
         for (int x = 0; x < size.width; ++x) {
           const float z = r.depth.at<float>(y, x);
@@ -60,6 +72,21 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
             out.instance.at<uint16_t>(y, x) = label;
           }
         }
+    }
+    // What the object would cover alone counts the part the border cuts off as well, as BOP's
+    // px_count_all does (its calc_gt_info renders into an image three times as wide and high):
+    // an instance half out of the image is half visible, not wholly.
+    if (!cut_off.empty()) {
+      Camera wide = camera;
+      wide.width = 3 * camera.width;
+      wide.height = 3 * camera.height;
+      wide.cx += camera.width;
+      wide.cy += camera.height;
+      std::vector<Pose> cut_poses;
+      for (std::size_t i : cut_off) cut_poses.push_back(objects[i].pose);
+      const std::vector<Rendering> whole = renderer.render(wide, cut_poses);
+      for (std::size_t k = 0; k < cut_off.size(); ++k)
+        out.full_pixels[cut_off[k]] = std::max(out.full_pixels[cut_off[k]], cv::countNonZero(whole[k].mask()));
     }
   }
   for (int y = 0; y < size.height; ++y)

@@ -22,7 +22,8 @@ struct SceneRendering {
   cv::Mat normals;   ///< CV_32FC3 unit normals in the camera frame, facing the camera; 0 where nothing is
   cv::Mat bgr;       ///< CV_8UC3
   cv::Mat instance;  ///< CV_16UC1: 1 + index of the object seen at each pixel, 0 for none
-  /// Pixels of each object that are visible, and that it would cover alone.
+  /// Pixels of each object that are visible, and that it would cover alone (the part the
+  /// image border cuts off included, as BOP counts px_count_all).
   std::vector<int> visible_pixels, full_pixels;
   /// CV_8UC1 silhouette of each object alone (255 inside): what it would cover unoccluded.
   std::vector<cv::Mat> full_masks;
