@@ -273,12 +273,12 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     hypotheses.push_back(h);
     dets.push_back(hypothesisDetection(h, banks_));
     dets.back().rotation_votes = rot.group_size;
-    rendered.push_back(poseOnViewingRay(rot.R, h, bank, camera));
+    rendered.push_back(poseOnViewingRay(rot.R, h, bank, camera, params_.initial_pose.range_along_ray));
     if (!rot.by_fit) continue;
     hypotheses.push_back(h);
     dets.push_back(hypothesisDetection(h, banks_));
     dets.back().rotation_votes = rot.by_fit_size;
-    rendered.push_back(poseOnViewingRay(*rot.by_fit, h, bank, camera));
+    rendered.push_back(poseOnViewingRay(*rot.by_fit, h, bank, camera, params_.initial_pose.range_along_ray));
   }
   const std::size_t n = hypotheses.size();
   if (renderers_.empty()) {

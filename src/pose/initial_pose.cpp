@@ -107,7 +107,8 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
   return out;
 }
 
-Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const TemplateBank& bank, const Camera& camera) {
+Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
+                      bool range_along_ray) {
   // The training camera looked at bank.centre, so the centre's range is the template's; the
   // cluster score measured how far the scene surface is from the template's (depth_offset).
   float range = h.distance;
@@ -115,9 +116,16 @@ Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const Templ
     const auto best = static_cast<std::size_t>(h.best_member);
     const BankTemplate& t = bank.templates.at(static_cast<std::size_t>(h.members[best].template_index));
     range = (t.pose.R * bank.centre + t.pose.t).norm();
-    if (best < h.member_scores.size()) range += h.member_scores[best].depth_offset;
+    const float offset = best < h.member_scores.size() ? h.member_scores[best].depth_offset : 0.f;
+    range = range_along_ray ? rangeOnRay(range, offset, h.x, h.y, camera) : range + offset;
   }
   return poseAtRange(R, h.x, h.y, range, bank.centre, camera);
+}
+
+float rangeOnRay(float template_range, float depth_offset, float x, float y, const Camera& camera) {
+  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
+                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  return (template_range + depth_offset) * ray.norm();  // ray.norm() = 1 / cos(theta)
 }
 
 Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const Eigen::Vector3f& centre,
