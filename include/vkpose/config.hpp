@@ -72,9 +72,9 @@ struct InitialPoseParams {
   /// 1 / cos(theta) (rangeOnRay): true converts it. Off (today's default), an object 20
   /// degrees off the axis starts 6 % short (5 cm at 0.85 m) and is rejected before ICP
   /// ("no scene depth near it"), so nothing is found in the image's outer part. On, the lying
-  /// stress set's average F1 rises from 0.837 to 0.919 (docs/pipeline.md, stage 6), but on the real
-  /// LM-O frame four look-alikes at its edges (unannotated objects taken for the ape and the
-  /// glue) then pass verification: it stays off until verification rejects them.
+  /// stress set's average F1 rises from 0.837 to 0.919 (docs/pipeline.md, stage 6), but on
+  /// the real LM-O frame four look-alikes at its edges (unannotated objects taken for the ape
+  /// and the glue) then pass verification: it stays off until verification rejects them.
   bool range_along_ray = false;
   /// A scene pixel under the rendered mask belongs to the object when its depth lies within
   /// this fraction of the object's diameter of the rendered depth there. Nearer is an
