@@ -189,5 +189,52 @@ TEST(Verify, SupportCellsAreWhereTheModelMeetsTheSceneDepth) {
   EXPECT_EQ(supportCells(on_surface, depth, camera, 0.015f, 8).size(), 6u * 6u);
 }
 
+// The contour test (VerifyParams::min_contour_edges): the outline of a posed model must run
+// along edges of the colour image where nothing hides it.
+TEST(Verify, ContourEdgesAreWhereTheOutlineMeetsAnImageEdge) {
+  Camera camera;
+  camera.width = 160;
+  camera.height = 120;
+  camera.fx = camera.fy = 150.0;
+  camera.cx = 80.0;
+  camera.cy = 60.0;
+  // A flat face 1 m away covering pixels [50, 110) x [30, 90), one point a pixel.
+  const auto face = [&](cv::Rect r) {
+    PointCloud points;
+    for (int v = r.y; v < r.y + r.height; ++v)
+      for (int u = r.x; u < r.x + r.width; ++u)
+        points.emplace_back(static_cast<float>((u - camera.cx) / camera.fx), static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+    return points;
+  };
+  const cv::Rect box(50, 30, 60, 60);
+  const PointCloud model = face(box);
+  cv::Mat depth(120, 160, CV_32FC1, cv::Scalar(1.2f));
+  depth(box).setTo(1.0f);
+  cv::Mat bgr(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
+  bgr(box).setTo(cv::Scalar(180, 170, 160));
+  EXPECT_GT(contourEdgeSupport(model, imageEdges(bgr), depth, camera, 0.01f), 0.95f) << "painted where it stands";
+
+  cv::Mat shifted(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
+  shifted(box + cv::Point(8, 8)).setTo(cv::Scalar(180, 170, 160));
+  EXPECT_LT(contourEdgeSupport(model, imageEdges(shifted), depth, camera, 0.01f), 0.1f) << "an object 8 px off";
+  const cv::Mat blank(120, 160, CV_8UC3, cv::Scalar(90, 90, 90));
+  EXPECT_EQ(contourEdgeSupport(model, imageEdges(blank), depth, camera, 0.01f), 0.f) << "no edge anywhere";
+
+  // An occluder 10 cm in front covers the left of the image: the outline there is not counted
+  // (its edge is the occluder's business), so the rest still scores as a match.
+  cv::Mat occluded_bgr = bgr.clone(), occluded_depth = depth.clone();
+  occluded_bgr(cv::Rect(0, 0, 56, 120)).setTo(cv::Scalar(40, 40, 40));
+  occluded_depth(cv::Rect(0, 0, 56, 120)).setTo(0.9f);
+  EXPECT_GT(contourEdgeSupport(model, imageEdges(occluded_bgr), occluded_depth, camera, 0.01f), 0.9f);
+
+  // A model cut by the image's border: the border is no edge of the object's, and not counted.
+  const cv::Rect cut(0, 30, 60, 60);
+  cv::Mat cut_bgr(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
+  cut_bgr(cut).setTo(cv::Scalar(180, 170, 160));
+  cv::Mat cut_depth(120, 160, CV_32FC1, cv::Scalar(1.2f));
+  cut_depth(cut).setTo(1.0f);
+  EXPECT_GT(contourEdgeSupport(face(cut), imageEdges(cut_bgr), cut_depth, camera, 0.01f), 0.95f);
+}
+
 }  // namespace
 }  // namespace vkpose

@@ -165,6 +165,12 @@ struct VerifyParams {
   /// Accept only if at least this share of the outline's samples (where the scene has depth
   /// on both sides, and nothing nearer outside) steps back.
   float min_silhouette_support = 0.55f;
+  /// Contour test: where the outline is visible (no occluder in front), the colour image
+  /// shows an edge along it, within 2 px (contourEdgeSupport). A look-alike of the right size
+  /// and the wrong shape, or one cut off by the image's border, leaves much of its outline
+  /// on no edge (LM-O: correct poses 0.52-0.95, a glue taken at the image's left edge 0.39).
+  /// Accept only if at least this share of the visible outline meets an edge. 0: off.
+  float min_contour_edges = 0.45f;
   /// Objects compete for scene points: best score first, each accepted detection claims the
   /// scene it explains (4 x 4 pixel cells where a visible model point meets the scene depth
   /// within see_through_tolerance); one whose explained cells are more than this share
@@ -185,9 +191,10 @@ struct VerifyParams {
   /// and the two are rendered and compared by colour and the depth residual over the whole
   /// mask; the turn replaces the pose when it scores symmetry_margin higher. 0: off.
   float look_alike_tolerance = 0.06f;
-  /// For meshes with colours that vary: the kept pose's rendered chromaticity must agree
-  /// with the frame's at least this much (a cup-shaped can, a carton's twin in other colours
-  /// fit the depth as well as the object). -1: off.
+  /// For meshes with colours (a PLY with vertex colours): the kept pose's rendered
+  /// chromaticity must agree with the frame's at least this much (a cup-shaped can, a
+  /// carton's twin in other colours, a brown ape taken on a blue cup fit the depth as well as
+  /// the object). -1: off.
   float min_colour_agreement = 0.2f;
 };
 /// Throws InputError naming the bad value.

@@ -58,6 +58,7 @@ struct Detection {
   float see_through = 0.f;     ///< share of the visible model points the camera sees through
   float depth_fit = 0.f;       ///< share of the visible model points within tolerance of the scene depth
   float silhouette_support = 0.f;  ///< share of the outline with a depth step behind it
+  float contour_edges = 0.f;       ///< share of the visible outline that meets an image edge along it
   /// Correlation (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
   /// where the pose fits the depth (appearanceAgreement); 1 when not measured (a mesh without
   /// colours, or of one colour).

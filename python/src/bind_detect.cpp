@@ -183,6 +183,7 @@ py::dict detectionDict(const Detection& d) {
   out["see_through"] = tidy(d.see_through);
   out["depth_fit"] = tidy(d.depth_fit);
   out["silhouette_support"] = tidy(d.silhouette_support);
+  out["contour_edges"] = tidy(d.contour_edges);
   out["colour_agreement"] = tidy(d.colour_agreement);
   out["icp_fitness"] = d.icp_fitness;
   out["icp_iterations"] = d.icp_iterations;
@@ -370,6 +371,7 @@ leaves the config as it was.)")
       .def_property_readonly("see_through", [](const PyDetection& p) { return tidy(p.d.see_through); })
       .def_property_readonly("depth_fit", [](const PyDetection& p) { return tidy(p.d.depth_fit); })
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
+      .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
                              "Correlation of the rendered mesh's chromaticity with the frame's; 1 when not measured")
       .def_property_readonly("icp_fitness", [](const PyDetection& p) { return p.d.icp_fitness; },

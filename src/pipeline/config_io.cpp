@@ -87,6 +87,8 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"verify", "silhouette_jump", "a depth step this large marks the outline, metres", &p.verify.silhouette_jump},
       {"verify", "min_silhouette_support", "share of the outline that must show a depth step, 0..1",
        &p.verify.min_silhouette_support},
+      {"verify", "min_contour_edges", "share of the visible outline that must meet an image edge, 0..1 (0: off)",
+       &p.verify.min_contour_edges},
       {"verify", "max_shared_support", "share of its scene support a better detection may already claim, 0..1",
        &p.verify.max_shared_support},
       {"verify", "resolve_symmetries", "render a pose's near-symmetric alternatives and keep the one colour and depth favour",

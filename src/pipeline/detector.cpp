@@ -362,7 +362,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   t0 = std::chrono::steady_clock::now();
   std::vector<VerifyResult> verified(n);
   std::vector<DepthAgreement> agreement(n);
-  std::vector<float> support(n, 0.f);
+  std::vector<float> support(n, 0.f), contour(n, 0.f);
+  const ImageEdges edges = imageEdges(scene_bgr);
   std::vector<std::vector<int>> explained(n);  // scene cells each pose explains, for the competition below
   const auto verifyCandidate = [&](std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
@@ -371,6 +372,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     verified[i] = verifyPose(model, initial[i].scene_points, vp);
     agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
     support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
+    contour[i] = contourEdgeSupport(model, edges, scene.depth_m, camera, vp.silhouette_jump);
     explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
     cpu_ms[i] += msSince(start);
   };
@@ -392,12 +394,23 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     const auto& symmetries = banks_[b].near_symmetries;
     if (!initial[i].ok || !verified[i].accepted) continue;
     if (!colourful_[b]) {
-      // No colours that vary (none, or one colour all over: LM-O's scans vary too little):
-      // nothing to compare but depth, and the turns fit the depth within the training
+      Detection& d = dets[i];
+      // Colours that vary too little to tell turns apart (LM-O's scans) still tell the object
+      // from a look-alike of another colour: its one pose rendered and compared.
+      if (!banks_[b].mesh.colours.empty() && params_.verify.min_colour_agreement > -1.f) {
+        const Pose& pose = refined[i].pose;
+        const cv::Rect window = projectedWindow(pose, banks_[b].centre, bounding_radius_[b], camera);
+        if (!window.empty()) {
+          const auto views = renderers_[b]->render(windowCamera(camera, window), {pose});
+          const AppearanceAgreement a = appearanceAgreement(views[0], window, scene_bgr, scene.depth_m,
+                                                            verify_params[i].see_through_tolerance, true);
+          if (a.colour_informative) d.colour_agreement = a.colour;
+        }
+      }
+      // Nothing to compare the turns by but depth, and they fit it within the training
       // tolerance by construction (ICP has had its say): listed, not rendered (on IC-BIN
       // rendering the cup's 7 turns cost 230 ms a frame to say "ambiguous").
       if (!params_.verify.resolve_symmetries || symmetries.empty()) continue;
-      Detection& d = dets[i];
       d.symmetry_alternatives.resize(1 + symmetries.size());
       for (std::size_t k = 0; k < symmetries.size(); ++k) {
         d.symmetry_alternatives[k + 1].angle_deg = symmetries[k].angle_deg;
@@ -556,6 +569,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     d.see_through = agreement[i].seen_through;
     d.depth_fit = agreement[i].fits;
     d.silhouette_support = support[i];
+    d.contour_edges = contour[i];
     d.score = d.collision_rate * (1.f - d.see_through) * d.silhouette_support;
     placeInImage(d, initial[i].model_points, bank.centre, camera);
     const VerifyParams& vp = verify_params[i];
@@ -567,6 +581,10 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     else if (d.silhouette_support < vp.min_silhouette_support)
       d.rejection = fmt::format("only {:.0f}% of the outline shows a depth step (at least {:.0f}%)",
                                 100 * d.silhouette_support, 100 * vp.min_silhouette_support);
+    else if (d.contour_edges < vp.min_contour_edges)
+      d.rejection = fmt::format("only {:.0f}% of its visible outline meets an edge in the image (at least {:.0f}%): "
+                                "something else of its size?",
+                                100 * d.contour_edges, 100 * vp.min_contour_edges);
     else if (d.colour_agreement < vp.min_colour_agreement)
       d.rejection = fmt::format("its colours do not match the scene's (agreement {:.2f}, at least {:.2f}): "
                                 "something else of its shape?",

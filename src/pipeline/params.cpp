@@ -88,6 +88,8 @@ void validateVerifyParams(const VerifyParams& params) {
   if (!(params.look_alike_tolerance >= 0.f && params.look_alike_tolerance <= 0.5f))
     throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}",
                                  params.look_alike_tolerance));
+  if (!(params.min_contour_edges >= 0.f && params.min_contour_edges <= 1.f))
+    throw InputError(fmt::format("the contour edge share must be in [0, 1], got {}", params.min_contour_edges));
   if (!(params.min_colour_agreement >= -1.f && params.min_colour_agreement <= 1.f))
     throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", params.min_colour_agreement));
 }

@@ -28,21 +28,33 @@ float depthAt(const cv::Mat& depth_m, float x, float y) {
 }
 }  // namespace
 
-float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
-                        float jump) {
-  CV_Assert(scene_depth_m.type() == CV_32FC1);
-  cv::Mat mask = cv::Mat::zeros(scene_depth_m.size(), CV_8UC1);
+namespace {
+/// A point of the projected model's outline, the outline's outward unit normal there, and
+/// the model's depth 3 px inside (0 where no model point projects near it).
+struct OutlineSample {
+  Eigen::Vector2f at, out;
+  float model_z_in = 0.f;
+};
+
+/// The outline of the camera-frame model points projected into an image of `size`, one sample
+/// a pixel (contours shorter than 8 px left out).
+std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const Camera& camera, cv::Size size) {
+  cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
+  cv::Mat model_z = cv::Mat::zeros(size, CV_32FC1);  // nearest model point a pixel, 0: none
   for (const auto& p : model_points) {
     if (!p.allFinite() || !(p.z() > 0.f)) continue;
     const Eigen::Vector2f uv = camera.project(p);
     const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
-    if (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows) mask.at<uint8_t>(v, u) = 255;
+    if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows) continue;
+    mask.at<uint8_t>(v, u) = 255;
+    float& z = model_z.at<float>(v, u);
+    if (z == 0.f || p.z() < z) z = p.z();
   }
   // The points are one per rendered pixel of a nearby pose: close the gaps a small move opens.
   cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  std::size_t steps = 0, usable = 0;
+  std::vector<OutlineSample> samples;
   for (const auto& contour : contours) {
     const int n = static_cast<int>(contour.size());
     if (n < 8) continue;
@@ -58,14 +70,82 @@ float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_dep
       const Eigen::Vector2f probe = c + 2.f * normal;
       const int pu = static_cast<int>(std::lround(probe.x())), pv = static_cast<int>(std::lround(probe.y()));
       if (pu >= 0 && pv >= 0 && pu < mask.cols && pv < mask.rows && mask.at<uint8_t>(pv, pu)) normal = -normal;
-      const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-      const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
-      if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
-      ++usable;
-      steps += z_out >= z_in + jump;
+      // The model's depth inside: at the probe 3 px in, or the nearest point of the 5 x 5
+      // pixels around it (the points are one a rendered pixel, with gaps).
+      const Eigen::Vector2f in = c - 3.f * normal;
+      const int iu = static_cast<int>(std::lround(in.x())), iv = static_cast<int>(std::lround(in.y()));
+      float z_in = 0.f;
+      for (int dv = -2; dv <= 2; ++dv)
+        for (int du = -2; du <= 2; ++du) {
+          const int u = iu + du, v = iv + dv;
+          if (u < 0 || v < 0 || u >= model_z.cols || v >= model_z.rows) continue;
+          const float z = model_z.at<float>(v, u);
+          if (z > 0.f && (z_in == 0.f || z < z_in)) z_in = z;
+        }
+      samples.push_back({c, normal, z_in});
     }
   }
+  return samples;
+}
+}  // namespace
+
+float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
+                        float jump) {
+  CV_Assert(scene_depth_m.type() == CV_32FC1);
+  std::size_t steps = 0, usable = 0;
+  for (const auto& [c, normal, model_z_in] : outlineSamples(model_points, camera, scene_depth_m.size())) {
+    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
+    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+    if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
+    ++usable;
+    steps += z_out >= z_in + jump;
+  }
   return usable ? static_cast<float>(steps) / static_cast<float>(usable) : 0.f;
+}
+
+ImageEdges imageEdges(const cv::Mat& bgr) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  ImageEdges edges;
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  // A light blur first: sensor noise and JPEG blocks make weak gradients everywhere.
+  cv::GaussianBlur(grey, grey, {3, 3}, 0);
+  cv::Sobel(grey, edges.dx, CV_32F, 1, 0, 3);
+  cv::Sobel(grey, edges.dy, CV_32F, 0, 1, 3);
+  return edges;
+}
+
+float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
+                         const Camera& camera, float jump, float min_gradient) {
+  CV_Assert(edges.dx.type() == CV_32FC1 && edges.dy.type() == CV_32FC1 && edges.dx.size() == scene_depth_m.size());
+  const float cos_max = std::cos(0.5236f);  // 30 degrees between the gradient and the outline's normal
+  const float min_sq = min_gradient * min_gradient;
+  std::size_t met = 0, usable = 0;
+  for (const auto& [c, normal, model_z_in] : outlineSamples(model_points, camera, scene_depth_m.size())) {
+    // An occluder hides the outline where the scene inside it lies nearer than the model, or
+    // where something right outside stands in front: its edges say nothing about the model.
+    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
+    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+    if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) continue;
+    if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) continue;
+    if (!(c.x() >= 2.f && c.y() >= 2.f && c.x() < float(edges.dx.cols - 2) && c.y() < float(edges.dx.rows - 2)))
+      continue;  // the image's border is no edge of the object's
+    ++usable;
+    for (int t = -2; t <= 2; ++t) {
+      const Eigen::Vector2f q = c + static_cast<float>(t) * normal;
+      const int u = static_cast<int>(std::lround(q.x())), v = static_cast<int>(std::lround(q.y()));
+      if (u < 0 || v < 0 || u >= edges.dx.cols || v >= edges.dx.rows) continue;
+      const float gx = edges.dx.at<float>(v, u), gy = edges.dy.at<float>(v, u);
+      const float sq = gx * gx + gy * gy;
+      if (sq < min_sq) continue;
+      // Either sign: the object may be darker or brighter than what lies behind it.
+      if (std::abs(gx * normal.x() + gy * normal.y()) >= cos_max * std::sqrt(sq)) {
+        ++met;
+        break;
+      }
+    }
+  }
+  return usable ? static_cast<float>(met) / static_cast<float>(usable) : 0.f;
 }
 
 DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,

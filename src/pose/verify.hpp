@@ -46,6 +46,24 @@ std::vector<int> supportCells(const PointCloud& model_points, const cv::Mat& sce
 /// whose outside lies at least `jump` farther. 0 when no sample is usable.
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera, float jump);
 
+/// The scene image's intensity gradients (Sobel of the lightly blurred grey image), computed
+/// once a frame for contourEdgeSupport.
+struct ImageEdges {
+  cv::Mat dx, dy;  ///< CV_32FC1
+};
+ImageEdges imageEdges(const cv::Mat& bgr);
+
+/// The contour test's share (see VerifyParams::min_contour_edges): of the projected model's
+/// outline samples (as silhouetteSupport's), those within 2 px of an image edge of at least
+/// `min_gradient` (Sobel units) running along the outline (gradient within 30 degrees of its
+/// normal). Samples an occluder hides (the scene inside the outline nearer than the model,
+/// or the scene outside nearer than inside, by `jump`) and samples on the image's border are
+/// left out. A look-alike of the right size in the wrong
+/// shape shows up here: a cup's handle must meet an edge where it is visible. 0 when no
+/// sample is usable.
+float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
+                         const Camera& camera, float jump, float min_gradient = 40.f);
+
 /// visible_model_points: camera-frame points of the model surface as the camera sees it at the
 /// pose under test. scene_points: camera-frame scene points (a crop or the whole frame).
 /// Non-finite points are ignored; empty inputs give phi = 0, rejected. Thread-safe.
