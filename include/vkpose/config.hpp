@@ -167,9 +167,9 @@ struct VerifyParams {
   float min_silhouette_support = 0.55f;
   /// Contour test: where the outline is visible (no occluder in front), the colour image
   /// shows an edge along it, within 2 px (contourEdgeSupport). A look-alike of the right size
-  /// and the wrong shape, or one cut off by the image's border, leaves much of its outline
-  /// on no edge (LM-O: correct poses 0.52-0.95, a glue taken at the image's left edge 0.39).
-  /// Accept only if at least this share of the visible outline meets an edge. 0: off.
+  /// and the wrong shape leaves much of its outline on no edge (lying seed 52: correct poses
+  /// 0.55-1.00, look-alikes 0.33; LM-O: correct 0.56-0.97). Accept only if at least this share
+  /// of the visible outline meets an edge. 0: off.
   float min_contour_edges = 0.45f;
   /// Objects compete for scene points: best score first, each accepted detection claims the
   /// scene it explains (4 x 4 pixel cells where a visible model point meets the scene depth

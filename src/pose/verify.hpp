@@ -62,7 +62,7 @@ ImageEdges imageEdges(const cv::Mat& bgr);
 /// shape shows up here: a cup's handle must meet an edge where it is visible. 0 when no
 /// sample is usable.
 float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
-                         const Camera& camera, float jump, float min_gradient = 40.f);
+                         const Camera& camera, float jump, float min_gradient = 20.f);
 
 /// visible_model_points: camera-frame points of the model surface as the camera sees it at the
 /// pose under test. scene_points: camera-frame scene points (a crop or the whole frame).
