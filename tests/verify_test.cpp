@@ -163,15 +163,21 @@ TEST(Verify, RealFrameRanksRefinedPoseAboveShiftedOnes) {
 namespace vkpose {
 namespace {
 
+/// A pinhole camera of `width` x `height` pixels, focal length `f` pixels, centred.
+Camera smallCamera(int width, int height, double f) {
+  Camera camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = camera.fy = f;
+  camera.cx = width / 2.0;
+  camera.cy = height / 2.0;
+  return camera;
+}
+
 // Objects compete for the scene they explain (VerifyParams::max_shared_support): the cells a
 // posed model explains are where its points meet the scene depth.
 TEST(Verify, SupportCellsAreWhereTheModelMeetsTheSceneDepth) {
-  Camera camera;
-  camera.width = 64;
-  camera.height = 48;
-  camera.fx = camera.fy = 60.0;
-  camera.cx = 32.0;
-  camera.cy = 24.0;
+  const Camera camera = smallCamera(64, 48, 60.0);
   cv::Mat depth(48, 64, CV_32FC1, cv::Scalar(1.0f));
   depth(cv::Rect(0, 0, 16, 48)).setTo(0.f);  // no depth on the left
   PointCloud on_surface, in_front;
@@ -192,12 +198,7 @@ TEST(Verify, SupportCellsAreWhereTheModelMeetsTheSceneDepth) {
 // The contour test (VerifyParams::min_contour_edges): the outline of a posed model must run
 // along edges of the colour image where nothing hides it.
 TEST(Verify, ContourEdgesAreWhereTheOutlineMeetsAnImageEdge) {
-  Camera camera;
-  camera.width = 160;
-  camera.height = 120;
-  camera.fx = camera.fy = 150.0;
-  camera.cx = 80.0;
-  camera.cy = 60.0;
+  const Camera camera = smallCamera(160, 120, 150.0);
   // A flat face 1 m away covering pixels [50, 110) x [30, 90), one point a pixel.
   const auto face = [&](cv::Rect r) {
     PointCloud points;
