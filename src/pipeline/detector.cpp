@@ -393,24 +393,13 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
     const auto& symmetries = banks_[b].near_symmetries;
     if (!initial[i].ok || !verified[i].accepted) continue;
-    if (!colourful_[b]) {
-      Detection& d = dets[i];
-      // Colours that vary too little to tell turns apart (LM-O's scans) still tell the object
-      // from a look-alike of another colour: its one pose rendered and compared.
-      if (!banks_[b].mesh.colours.empty() && params_.verify.min_colour_agreement > -1.f) {
-        const Pose& pose = refined[i].pose;
-        const cv::Rect window = projectedWindow(pose, banks_[b].centre, bounding_radius_[b], camera);
-        if (!window.empty()) {
-          const auto views = renderers_[b]->render(windowCamera(camera, window), {pose});
-          const AppearanceAgreement a = appearanceAgreement(views[0], window, scene_bgr, scene.depth_m,
-                                                            verify_params[i].see_through_tolerance, true);
-          if (a.colour_informative) d.colour_agreement = a.colour;
-        }
-      }
-      // Nothing to compare the turns by but depth, and they fit it within the training
-      // tolerance by construction (ICP has had its say): listed, not rendered (on IC-BIN
-      // rendering the cup's 7 turns cost 230 ms a frame to say "ambiguous").
-      if (!params_.verify.resolve_symmetries || symmetries.empty()) continue;
+    Detection& d = dets[i];
+    const bool resolve = params_.verify.resolve_symmetries && !symmetries.empty();
+    if (!colourful_[b] && resolve) {
+      // No colours that vary (none, or LM-O's scans, which vary too little): nothing to
+      // compare the turns by but depth, and they fit it within the training tolerance by
+      // construction (ICP has had its say): listed, not rendered (on IC-BIN rendering the
+      // cup's 7 turns cost 230 ms a frame to say "ambiguous").
       d.symmetry_alternatives.resize(1 + symmetries.size());
       for (std::size_t k = 0; k < symmetries.size(); ++k) {
         d.symmetry_alternatives[k + 1].angle_deg = symmetries[k].angle_deg;
@@ -418,10 +407,12 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
       }
       d.symmetry_compared = false;
       d.ambiguous_symmetry = true;
-      continue;
     }
-    const bool turns = params_.verify.resolve_symmetries && !symmetries.empty();
-    if (!turns && !(params_.verify.min_colour_agreement > -1.f)) continue;
+    // Colours that vary too little to tell turns apart still tell the object from a
+    // look-alike of another colour: then only the pose itself is rendered and compared.
+    const bool turns = colourful_[b] && resolve;
+    const bool colour_test = !banks_[b].mesh.colours.empty() && params_.verify.min_colour_agreement > -1.f;
+    if (!turns && !colour_test) continue;
     std::vector<Pose> poses{refined[i].pose};
     if (turns)
       for (const auto& s : symmetries) poses.push_back(compose(refined[i].pose, s.transform()));
@@ -444,7 +435,6 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     }
     const float margin = params_.verify.symmetry_margin;
     const auto [chosen, won_by] = chooseAlternative(alts, margin);
-    Detection& d = dets[i];
     if (informative) d.colour_agreement = alts[chosen].colour;
     if (turns) {
       d.symmetry_chosen = static_cast<int>(chosen);
