@@ -371,8 +371,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     const VerifyParams& vp = verify_params[i];
     verified[i] = verifyPose(model, initial[i].scene_points, vp);
     agreement[i] = depthAgreement(model, scene.depth_m, camera, vp.see_through_tolerance);
-    support[i] = silhouetteSupport(model, scene.depth_m, camera, vp.silhouette_jump);
-    contour[i] = contourEdgeSupport(model, edges, scene.depth_m, camera, vp.silhouette_jump);
+    const auto outline = outlineSamples(model, camera, scene.depth_m.size());
+    support[i] = silhouetteSupport(outline, scene.depth_m, vp.silhouette_jump);
+    contour[i] = contourEdgeSupport(outline, edges, scene.depth_m, vp.silhouette_jump);
     explained[i] = supportCells(model, scene.depth_m, camera, vp.see_through_tolerance);
     cpu_ms[i] += msSince(start);
   };

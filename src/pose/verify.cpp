@@ -28,16 +28,6 @@ float depthAt(const cv::Mat& depth_m, float x, float y) {
 }
 }  // namespace
 
-namespace {
-/// A point of the projected model's outline, the outline's outward unit normal there, and
-/// the model's depth 3 px inside (0 where no model point projects near it).
-struct OutlineSample {
-  Eigen::Vector2f at, out;
-  float model_z_in = 0.f;
-};
-
-/// The outline of the camera-frame model points projected into an image of `size`, one sample
-/// a pixel (contours shorter than 8 px left out).
 std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const Camera& camera, cv::Size size) {
   cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
   cv::Mat model_z = cv::Mat::zeros(size, CV_32FC1);  // nearest model point a pixel, 0: none
@@ -87,13 +77,16 @@ std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const 
   }
   return samples;
 }
-}  // namespace
 
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
                         float jump) {
+  return silhouetteSupport(outlineSamples(model_points, camera, scene_depth_m.size()), scene_depth_m, jump);
+}
+
+float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump) {
   CV_Assert(scene_depth_m.type() == CV_32FC1);
   std::size_t steps = 0, usable = 0;
-  for (const auto& [c, normal, model_z_in] : outlineSamples(model_points, camera, scene_depth_m.size())) {
+  for (const auto& [c, normal, model_z_in] : outline) {
     const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
     const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
     if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
@@ -117,11 +110,17 @@ ImageEdges imageEdges(const cv::Mat& bgr) {
 
 float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
                          const Camera& camera, float jump, float min_gradient) {
+  return contourEdgeSupport(outlineSamples(model_points, camera, scene_depth_m.size()), edges, scene_depth_m, jump,
+                            min_gradient);
+}
+
+float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageEdges& edges,
+                         const cv::Mat& scene_depth_m, float jump, float min_gradient) {
   CV_Assert(edges.dx.type() == CV_32FC1 && edges.dy.type() == CV_32FC1 && edges.dx.size() == scene_depth_m.size());
   const float cos_max = std::cos(0.5236f);  // 30 degrees between the gradient and the outline's normal
   const float min_sq = min_gradient * min_gradient;
   std::size_t met = 0, usable = 0;
-  for (const auto& [c, normal, model_z_in] : outlineSamples(model_points, camera, scene_depth_m.size())) {
+  for (const auto& [c, normal, model_z_in] : outline) {
     // An occluder hides the outline where the scene inside it lies nearer than the model, or
     // where something right outside stands in front: its edges say nothing about the model.
     const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;

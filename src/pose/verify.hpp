@@ -39,12 +39,25 @@ DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& sce
 std::vector<int> supportCells(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
                               float tolerance, int cell = 4);
 
+/// A point of the projected model's outline, the outline's outward unit normal there, and
+/// the model's depth 3 px inside (0 where no model point projects near it).
+struct OutlineSample {
+  Eigen::Vector2f at, out;
+  float model_z_in = 0.f;
+};
+
+/// The outline of the camera-frame model points projected into an image of `size`, one sample
+/// a pixel (contours shorter than 8 px left out). The silhouette and contour tests read the
+/// same samples: the detector computes them once a pose.
+std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const Camera& camera, cv::Size size);
+
 /// The silhouette test's share (see VerifyParams::silhouette_jump): the outline of the
 /// camera-frame model points projected into the image, sampled every pixel; at each sample the
 /// scene depth 3 px inside and 4 px outside along the outline's normal. Samples where either
 /// has no depth or the outside is nearer (an occluder) are left out; the share is of the rest
 /// whose outside lies at least `jump` farther. 0 when no sample is usable.
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera, float jump);
+float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump);
 
 /// The scene image's intensity gradients (Sobel of the lightly blurred grey image), computed
 /// once a frame for contourEdgeSupport.
@@ -63,6 +76,8 @@ ImageEdges imageEdges(const cv::Mat& bgr);
 /// sample is usable.
 float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
                          const Camera& camera, float jump, float min_gradient = 20.f);
+float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageEdges& edges,
+                         const cv::Mat& scene_depth_m, float jump, float min_gradient = 20.f);
 
 /// visible_model_points: camera-frame points of the model surface as the camera sees it at the
 /// pose under test. scene_points: camera-frame scene points (a crop or the whole frame).
