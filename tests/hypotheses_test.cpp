@@ -179,6 +179,33 @@ TEST(Nms, KeepsTheBestWithinTheRadiusAroundFixedCentres) {
   EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f), scored(151, 100, 0.8f)}, banks, 500, p).size(), 2u);
 }
 
+// A small part's cluster score cannot tell it from a floor or a box corner (its depth crops
+// sit up to T pixels off), so parts under 10 cm are ranked by gamma times the number of
+// templates that agree on the place; a larger object keeps gamma alone.
+TEST(Nms, RanksSmallPartsByTheTemplatesThatAgreeToo) {
+  const auto withMembers = [](Hypothesis h, int n) {
+    h.members.resize(static_cast<std::size_t>(n));
+    return h;
+  };
+  NmsParams p;
+  p.radius_px = 30.f;
+  ASSERT_EQ(p.template_weight, 1.f);
+  // A floor that fits 0.6 with 4 templates against the part at 0.3 with 40, 10 px apart.
+  const std::vector<Hypothesis> hyps{withMembers(scored(100, 100, 0.6f), 4), withMembers(scored(110, 100, 0.3f), 40)};
+  const std::vector<TemplateBank> part{fakeBank(1, {0.5f}, 0.04f)}, object{fakeBank(1, {0.5f}, 0.2f)};
+  auto kept = suppressNonMaxima(hyps, part, 500, p);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_FLOAT_EQ(kept[0].x, 110.f);
+  EXPECT_FLOAT_EQ(nmsRank(kept[0], part, p), 0.3f * 40.f);
+  kept = suppressNonMaxima(hyps, object, 500, p);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_FLOAT_EQ(kept[0].x, 100.f);
+  p.template_weight = 0.f;  // gamma for every object
+  kept = suppressNonMaxima(hyps, part, 500, p);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_FLOAT_EQ(kept[0].x, 100.f);
+}
+
 TEST(ViewingRay, TurnsTheOpticalAxisOntoThePixelsRay) {
   Camera cam;
   for (auto [x, y] : {std::pair{0.f, 0.f}, {639.f, 479.f}, {cam.cx, cam.cy}, {100.f, 400.f}}) {

@@ -147,6 +147,17 @@ TEST(UpAxis, OtherRestingPosesAreTheSidesItLiesOnThatNoNearSymmetryCovers) {
   }
 }
 
+// --resting auto (train's default): a part smaller than 10 cm lies any way up in a bin, so
+// training covers its other resting poses; a larger object is trained standing.
+TEST(UpAxis, RestingAutoTrainsEveryPoseOfASmallPartOnly) {
+  EXPECT_TRUE(trainsOtherRestingPoses("auto", 0.04f));
+  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.1f));
+  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.25f));
+  EXPECT_TRUE(trainsOtherRestingPoses("all", 0.25f));
+  EXPECT_FALSE(trainsOtherRestingPoses("up", 0.04f));
+  EXPECT_THROW(trainsOtherRestingPoses("sideways", 0.04f), InputError);
+}
+
 TEST(UpAxis, EachRestingPoseHasAHemisphereOfViews) {
   ViewSamplingParams params;
   params.viewpoints = 40;

@@ -55,6 +55,13 @@ struct NmsParams {
   float radius_fraction = 0.5f;
   /// Suppress across objects too (one place in the image holds one object).
   bool across_objects = true;
+  /// Parts smaller than 10 cm (kSmallPartDiameterM) are ranked by gamma * (templates in the
+  /// cluster)^w instead of gamma alone. How many templates agree on a place is evidence the
+  /// cluster score cannot see for parts a few LINEMOD cells across: their depth crops sit up to
+  /// T pixels off, so a bare floor or a box's corner fits better than the part itself
+  /// (docs/pipeline.md, stage 5). Larger objects keep gamma, which ranks them better. 0: gamma
+  /// for every object.
+  float template_weight = 1.f;
 };
 
 struct InitialPoseParams {

@@ -225,7 +225,8 @@ void bindCore(py::module_& m) {
         params.symmetric = symmetric;
         if (!camera.is_none()) params.camera = cameraOf(camera, 640, 480, "camera");
         if (up != "auto") params.views.up = parseUpAxis(up);
-        if (resting != "all" && resting != "up") valueError(fmt::format("resting: '{}' is neither 'all' nor 'up'", resting));
+        if (resting != "auto" && resting != "all" && resting != "up")
+          valueError(fmt::format("resting: '{}' is none of 'auto', 'all', 'up'", resting));
         if (!(max_view_angle >= 1.f && max_view_angle <= 180.f))
           valueError(fmt::format("max_view_angle: {} is not within 1..180 degrees", max_view_angle));
         validateTrainingParams(params);
@@ -238,7 +239,7 @@ void bindCore(py::module_& m) {
         const Mesh mesh = loadMesh(path, mesh_units);
         const UpAxisChoice choice = findUpAxis(mesh);
         if (up == "auto") params.views.up = choice.up;
-        if (resting == "all" && !params.views.full_sphere)
+        if (trainsOtherRestingPoses(resting, mesh.diameter) && !params.views.full_sphere)
           params.views.other_ups = otherRestingUps(
               choice, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
         const std::vector<TrainingView> training_views =
@@ -255,7 +256,7 @@ void bindCore(py::module_& m) {
       py::arg("mesh"), py::kw_only(), py::arg("units") = "auto", py::arg("views") = 216,
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
-      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "up", py::arg("device") = py::none(),
+      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "auto", py::arg("device") = py::none(),
       py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
@@ -268,8 +269,9 @@ keep viewpoints within this angle of the up axis, degrees. features: per modalit
 camera: the sensor (a Camera, a camera.json path, or a 3x3 K): templates are scale-specific.
 symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end it stands on,
 +z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. resting: 'up' (views about
-the up axis only) or 'all' (also a hemisphere about each other pose it rests in, lying or upside
-down, that no near-symmetry covers: up to 6x the templates). device: None, an index or a Device. cache_dir: a folder
+the up axis only), 'all' (also a hemisphere about each other pose it rests in, lying or upside
+down, that no near-symmetry covers: up to 6x the templates) or 'auto' (all for a part smaller
+than 10 cm across, up otherwise). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

@@ -156,6 +156,8 @@ def test_training_checks_its_arguments_before_any_work(tmp_path):
         vkpose.train(tmp_path / "nosuch.stl")
     with pytest.raises(ValueError, match="progress"):
         vkpose.train(mesh, progress=5)
+    with pytest.raises(ValueError, match="resting"):
+        vkpose.train(mesh, resting="sideways")
 
 
 def test_training_finds_the_up_axis(meshes):

@@ -17,7 +17,7 @@ using util::ProgressBar;
 namespace {
 struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
-      up = "auto", resting = "up";
+      up = "auto", resting = "auto";
   int views = 216, features = 63;
   float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
   bool symmetric = false, force = false;
@@ -65,8 +65,9 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--resting", opt->resting,
                   "up: views about the up axis only (objects standing upright); all: also a hemisphere about each "
                   "other pose the object rests in (lying on a side, upside down) that no near-symmetry covers, for "
-                  "objects tipped over or in bins: up to 6x the templates and the matching time")
-      ->check(CLI::IsMember({"all", "up"}))
+                  "objects tipped over or in bins: up to 6x the templates and the matching time; auto: all for a "
+                  "part smaller than 10 cm across (small parts lie any way up in bins), up otherwise")
+      ->check(CLI::IsMember({"auto", "all", "up"}))
       ->capture_default_str();
   sub->add_option("--max-view-angle", opt->max_view_angle,
                   "Keep only viewpoints within this angle of the object's up axis, degrees (e.g. 40 for parts that stand "
@@ -113,11 +114,16 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
     if (!params.views.full_sphere) {
       const std::vector<Eigen::Vector3f> others = otherRestingUps(
           up, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
-      if (opt->resting == "all") params.views.other_ups = others;
+      const bool all = trainsOtherRestingPoses(opt->resting, mesh.diameter);
+      if (all) params.views.other_ups = others;
       fmt::print("other resting poses: {} ({})\n", restingUpsText(others),
-                 others.empty()                ? "it stands on no other side, or near-symmetries cover them"
-                 : opt->resting == "all" ? "a hemisphere of views about each as well"
-                                         : "not trained: pass --resting all to find it lying down too");
+                 others.empty() ? "it stands on no other side, or near-symmetries cover them"
+                 : all && opt->resting == "auto"
+                     ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
+                                   "in a bin; --resting up trains it standing only",
+                                   1e3f * mesh.diameter)
+                 : all ? "a hemisphere of views about each as well"
+                       : "not trained: pass --resting all to find it lying down too");
     }
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);

@@ -108,13 +108,20 @@ float projectedDiameter(const Hypothesis& h, const std::vector<TemplateBank>& ba
   return h.distance > 0.f ? static_cast<float>(fx) * d / h.distance : 0.f;
 }
 
+float nmsRank(const Hypothesis& h, const std::vector<TemplateBank>& banks, const NmsParams& params) {
+  if (params.template_weight == 0.f || !(banks[static_cast<std::size_t>(h.bank)].diameter < kSmallPartDiameterM))
+    return h.score;
+  return h.score * std::pow(static_cast<float>(h.members.size()), params.template_weight);
+}
+
 std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
                                           double fx, const NmsParams& params) {
   if (!(params.radius_px >= 0.f) || !(params.radius_fraction > 0.f))
     throw InputError("NMS radius must be positive (radius_px >= 0, radius_fraction > 0)");
-  // Best score first; ties broken by position so the order never depends on the input order.
-  std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& a, const Hypothesis& b) {
-    return std::tie(b.score, a.bank, a.y, a.x) < std::tie(a.score, b.bank, b.y, b.x);
+  // Best rank first; ties broken by position so the order never depends on the input order.
+  std::stable_sort(hypotheses.begin(), hypotheses.end(), [&](const Hypothesis& a, const Hypothesis& b) {
+    const float ra = nmsRank(a, banks, params), rb = nmsRank(b, banks, params);
+    return std::tie(rb, a.bank, a.y, a.x) < std::tie(ra, b.bank, b.y, b.x);
   });
   std::vector<Hypothesis> kept;
   for (auto& h : hypotheses) {

@@ -69,7 +69,11 @@ struct Hypothesis {
 std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, const std::vector<TemplateBank>& banks,
                                          const ClusterParams& params = {});
 
-/// Stage 5: hypotheses sorted by score (best first), then each survives unless a better
+/// What stage 5 ranks by: gamma; for a part smaller than kSmallPartDiameterM, times the
+/// cluster's template count to the power `template_weight`.
+float nmsRank(const Hypothesis& h, const std::vector<TemplateBank>& banks, const NmsParams& params);
+
+/// Stage 5: hypotheses sorted by nmsRank (best first), then each survives unless a better
 /// survivor's centre lies within the radius (centres stay where they are; nothing merges).
 /// `fx` turns the banks' diameters at the hypotheses' distances into pixels.
 std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,

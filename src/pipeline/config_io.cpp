@@ -37,6 +37,7 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"score", "top_members", "the cluster score is the mean of this many best members", &p.score.top_members},
       {"nms", "radius_px", "suppression radius, pixels (0: radius_fraction of the object's size)", &p.nms.radius_px},
       {"nms", "radius_fraction", "suppression radius, share of the larger projected diameter", &p.nms.radius_fraction},
+      {"nms", "template_weight", "parts under 10 cm: rank by gamma * (templates in the cluster)^w (0: gamma alone)", &p.nms.template_weight},
       {"nms", "across_objects", "suppress across objects too (without poses)", &p.nms.across_objects},
       {"detector", "estimate_poses", "run stages 6-8 (false: stop after NMS)", &p.estimate_poses},
       {"detector", "min_score", "without poses: smallest cluster score gamma, 0..1", &p.min_score},

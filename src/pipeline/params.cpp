@@ -161,6 +161,8 @@ void validateDetectorParams(const DetectorParams& p) {
                                  p.cluster.position_step_px, p.cluster.min_templates));
   if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f))
     throw InputError("the NMS radius must be 0 or more pixels and its fraction more than 0");
+  if (!(p.nms.template_weight >= 0.f && p.nms.template_weight <= 4.f))
+    throw InputError(fmt::format("the NMS template weight must be in [0, 4], not {}", p.nms.template_weight));
   validateScoreParams(p.score);
   if (!(p.min_score >= 0.f && p.min_score <= 1.f)) throw InputError("minimum score must be in [0, 1]");
   if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");

@@ -182,4 +182,11 @@ std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const E
   return out;
 }
 
+bool trainsOtherRestingPoses(const std::string& resting, float diameter_m) {
+  if (resting == "all") return true;
+  if (resting == "up") return false;
+  if (resting == "auto") return diameter_m < kSmallPartDiameterM;
+  throw InputError(fmt::format("resting: '{}' is none of auto, all, up", resting));
+}
+
 }  // namespace vkpose
