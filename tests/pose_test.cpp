@@ -138,6 +138,15 @@ TEST(InitialRotation, StartsAlsoFromTheGroupThatFitsTheSceneBest) {
   // Without stage 4's scores (estimate_poses off, or scored elsewhere): one start.
   h.member_scores.clear();
   EXPECT_FALSE(initialRotation(h, bank, camera).by_fit.has_value());
+  // A small part's starts (small_part_starts): the next largest groups as well, by_fit left
+  // out where it is one of them.
+  EXPECT_TRUE(initialRotation(h, bank, camera, {}, {}, 1).more.empty());
+  scored(0.02f, 0.001f);
+  r = initialRotation(h, bank, camera, {}, {}, 4);
+  ASSERT_EQ(r.more.size(), 1u);  // two groups: about the identity (three) and 70-72 deg about x
+  EXPECT_EQ(r.more_sizes, (std::vector<int>{2}));
+  EXPECT_LT(rotationDistance(r.more[0], rot(71, x)) / kDeg, 0.5f);
+  EXPECT_FALSE(r.by_fit.has_value());  // the best fit is that group: no third start
 }
 
 /// The scene: a box on a wall at 0.8 m; the hypothesis: the same box rendered `offset` away.

@@ -74,6 +74,12 @@ struct InitialPoseParams {
   /// --resting all) holds groups of two or three templates, and the largest is often the
   /// wrong one. Both starts are refined and verified; the better survives.
   bool second_start_by_fit = true;
+  /// Parts smaller than 10 cm (kSmallPartDiameterM): starts a hypothesis from this many of
+  /// its largest rotation groups (and by_fit where that is none of them). A small part's
+  /// cluster holds the views of all its resting poses, and on a bracket 30-60 pixels across
+  /// the largest group is often a look-alike view (flat side for flat side); each start costs
+  /// a few milliseconds there, and the best verified one survives. 1: the largest only.
+  int small_part_starts = 4;
   /// Where stage 6 puts a hypothesis: the template's range plus the cluster score's depth
   /// offset is a z-range, and off the optical axis the range along the ray is longer by
   /// 1 / cos(theta) (rangeOnRay): true converts it. Off (today's default), an object 20

@@ -269,16 +269,17 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   std::vector<Pose> rendered;
   for (const Hypothesis& h : clusters) {
     const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
-    const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose, params_.score);
-    hypotheses.push_back(h);
-    dets.push_back(hypothesisDetection(h, banks_));
-    dets.back().rotation_votes = rot.group_size;
-    rendered.push_back(poseOnViewingRay(rot.R, h, bank, camera, params_.initial_pose.range_along_ray));
-    if (!rot.by_fit) continue;
-    hypotheses.push_back(h);
-    dets.push_back(hypothesisDetection(h, banks_));
-    dets.back().rotation_votes = rot.by_fit_size;
-    rendered.push_back(poseOnViewingRay(*rot.by_fit, h, bank, camera, params_.initial_pose.range_along_ray));
+    const int starts = bank.diameter < kSmallPartDiameterM ? params_.initial_pose.small_part_starts : 1;
+    const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose, params_.score, starts);
+    const auto start = [&](const Eigen::Matrix3f& R, int votes) {
+      hypotheses.push_back(h);
+      dets.push_back(hypothesisDetection(h, banks_));
+      dets.back().rotation_votes = votes;
+      rendered.push_back(poseOnViewingRay(R, h, bank, camera, params_.initial_pose.range_along_ray));
+    };
+    start(rot.R, rot.group_size);
+    for (std::size_t k = 0; k < rot.more.size(); ++k) start(rot.more[k], rot.more_sizes[k]);
+    if (rot.by_fit) start(*rot.by_fit, rot.by_fit_size);
   }
   const std::size_t n = hypotheses.size();
   if (renderers_.empty()) {

@@ -52,6 +52,10 @@ struct InitialRotation {
   /// sums highest, when that is not the largest group (farther than tau_theta from R).
   std::optional<Eigen::Matrix3f> by_fit;
   int by_fit_size = 0;  ///< templates in that group
+  /// With `starts` > 1: the means of the next largest groups, largest first, up to starts - 1
+  /// (by_fit is left out when it is one of them), and their sizes.
+  std::vector<Eigen::Matrix3f> more;
+  std::vector<int> more_sizes;
 };
 
 /// Stage 6, rotation: every member's template rotation is turned onto the viewing ray through
@@ -59,9 +63,10 @@ struct InitialRotation {
 /// about 30 degrees at the corners of a 640x480 Kinect image); the rotations are clustered at
 /// tau_theta, best similarity first, and the largest group's mean is the initial rotation.
 /// The members that stage 4 scored vote again, each by its fit to the scene at `score`'s units
-/// (MemberScore::fit), for by_fit.
+/// (MemberScore::fit), for by_fit. `starts` > 1 also returns the next largest groups (more).
 InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, const Camera& camera,
-                                const InitialPoseParams& params = {}, const ScoreParams& score = {});
+                                const InitialPoseParams& params = {}, const ScoreParams& score = {},
+                                int starts = 1);
 
 /// The range of the object's centre on the viewing ray through pixel (x, y), from the range of
 /// a template's centre and the depth offset the cluster score measured against the scene
