@@ -59,9 +59,10 @@ struct Detection {
   float depth_fit = 0.f;       ///< share of the visible model points within tolerance of the scene depth
   float silhouette_support = 0.f;  ///< share of the outline with a depth step behind it
   float contour_edges = 0.f;       ///< share of the visible outline that meets an image edge along it
-  /// Correlation (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
-  /// where the pose fits the depth (appearanceAgreement); 1 when not measured (a mesh without
-  /// colours, or of one colour).
+  /// Agreement (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
+  /// where the pose fits the depth (appearanceAgreement): a correlation where the rendering
+  /// shows several colours, a match of the colour itself where it shows one; 1 when not
+  /// measured (a mesh without vertex colours, or the test turned off).
   float colour_agreement = 1.f;
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
