@@ -204,6 +204,7 @@ TEST(ScaledLengths, LengthsTheUserSetAreKept) {
   for (const ScaledLength& s : scaledLengths())
     EXPECT_NE(table.find(s.section + "." + s.key), std::string::npos);
   EXPECT_NE(table.find("[follows the object and the sensor]"), std::string::npos);
+  EXPECT_NE(table.find("Parts smaller than 10 cm are also ranked and started differently"), std::string::npos);
 }
 
 TEST(SensorProfiles, NamesFilesAndWhatTheySet) {

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "vkpose/config.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/frame.hpp"
 #include "vkpose/geometry.hpp"
@@ -135,13 +136,10 @@ std::string describe(const NearSymmetry& s);
 std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const Eigen::Vector3f& up,
                                              const std::vector<NearSymmetry>& symmetries);
 
-/// Below this diameter `--resting auto` trains every resting pose: parts of a few centimetres
-/// (nuts, brackets, nozzles) are picked from bins and lie any way up, while larger objects
-/// mostly stand (the same 10 cm from which the pose stages' lengths are the defaults).
-inline constexpr float kSmallPartDiameterM = 0.1f;
-
 /// Whether training covers the other resting poses: `resting` is "all", "up" or "auto" (all for
-/// a part smaller than kSmallPartDiameterM). Throws InputError for anything else.
+/// a part smaller than kSmallPartDiameterM, config.hpp: parts of a few centimetres are picked
+/// from bins and lie any way up, while larger objects mostly stand). Throws InputError for
+/// anything else.
 bool trainsOtherRestingPoses(const std::string& resting, float diameter_m);
 
 /// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`

@@ -9,6 +9,13 @@
 
 namespace vkpose {
 
+/// Objects smaller than this (metres across) are small parts: the pose stages' lengths follow
+/// their size (kScaleReferenceDiameter), training covers every resting pose (`--resting
+/// auto`), NMS ranks them by their templates too (NmsParams::template_weight) and stage 6
+/// starts them from several rotations (InitialPoseParams::small_part_starts). Everything of
+/// 10 cm and more (LM-O, IC-BIN, the demo, Tejani's objects) takes none of these paths.
+inline constexpr float kSmallPartDiameterM = 0.1f;
+
 // ---- stage parameters ------------------------------------------------------------------
 
 struct MatchParams {
@@ -282,7 +289,7 @@ struct ScaledLength {
   float noise_multiple = 1.f;
   std::string why;
 };
-constexpr float kScaleReferenceDiameter = 0.1f;
+constexpr float kScaleReferenceDiameter = kSmallPartDiameterM;
 
 /// Every scaled length, in pipeline order.
 const std::vector<ScaledLength>& scaledLengths();

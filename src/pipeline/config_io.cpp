@@ -200,6 +200,13 @@ std::string configTable(const DetectorParams& params) {
   out += fmt::format("{:<42} {:>4}  {}\n", "length", "k", "why it follows the object and the sensor");
   for (const ScaledLength& s : scaledLengths())
     out += fmt::format("{:<42} {:>4g}  {}\n", s.section + "." + s.key, s.noise_multiple, s.why);
+  out += fmt::format(
+      "\nParts smaller than {:g} cm are also ranked and started differently (their own settings; larger\n"
+      "objects ignore them): nms.template_weight ranks their hypotheses by gamma x templates^w (a part a few\n"
+      "LINEMOD cells across misaligns its depth crops, so gamma alone prefers bare floor), and\n"
+      "initial_pose.small_part_starts starts each from that many rotation groups. `vkpose train --resting\n"
+      "auto` (the default) trains every resting pose of such a part.\n",
+      100 * kSmallPartDiameterM);
   return out;
 }
 
