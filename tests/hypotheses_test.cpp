@@ -206,6 +206,29 @@ TEST(Nms, RanksSmallPartsByTheTemplatesThatAgreeToo) {
   EXPECT_FLOAT_EQ(kept[0].x, 100.f);
 }
 
+// A small part's right view often sits in the cluster next to a look-alike one, so within the
+// part NMS keeps hypotheses a tenth of its diameter apart (verification removes duplicates);
+// across objects and for larger objects the radius stays half the diameter.
+TEST(Nms, KeepsASmallPartsNeighbouringViews) {
+  NmsParams p;
+  ASSERT_FLOAT_EQ(p.small_part_radius_fraction, 0.1f);
+  // 0.04 m at 0.5 m with fx 500: 40 px across, so 4 px within the part and 20 px otherwise.
+  const std::vector<TemplateBank> part{fakeBank(1, {0.5f}, 0.04f)}, object{fakeBank(1, {0.5f}, 0.2f)};
+  const std::vector<Hypothesis> hyps{scored(100, 100, 0.9f), scored(103, 100, 0.8f), scored(112, 100, 0.7f)};
+  auto kept = suppressNonMaxima(hyps, part, 500, p);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_FLOAT_EQ(kept[0].x, 100.f);
+  EXPECT_FLOAT_EQ(kept[1].x, 112.f);
+  // A 0.2 m object keeps one (100 px radius).
+  EXPECT_EQ(suppressNonMaxima(hyps, object, 500, p).size(), 1u);
+  // Two small parts at one place: one object there, at the usual radius (20 px).
+  const std::vector<TemplateBank> parts{fakeBank(1, {0.5f}, 0.04f), fakeBank(1, {0.5f}, 0.04f)};
+  EXPECT_EQ(suppressNonMaxima({scored(100, 100, 0.9f, 0), scored(112, 100, 0.8f, 1)}, parts, 500, p).size(), 1u);
+  // The same share as everyone else when asked.
+  p.small_part_radius_fraction = p.radius_fraction;
+  EXPECT_EQ(suppressNonMaxima(hyps, part, 500, p).size(), 1u);
+}
+
 TEST(ViewingRay, TurnsTheOpticalAxisOntoThePixelsRay) {
   Camera cam;
   for (auto [x, y] : {std::pair{0.f, 0.f}, {639.f, 479.f}, {cam.cx, cam.cy}, {100.f, 400.f}}) {

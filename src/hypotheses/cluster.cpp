@@ -116,21 +116,34 @@ float nmsRank(const Hypothesis& h, const std::vector<TemplateBank>& banks, const
 
 std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
                                           double fx, const NmsParams& params) {
-  if (!(params.radius_px >= 0.f) || !(params.radius_fraction > 0.f))
+  if (!(params.radius_px >= 0.f) || !(params.radius_fraction > 0.f) || !(params.small_part_radius_fraction > 0.f))
     throw InputError("NMS radius must be positive (radius_px >= 0, radius_fraction > 0)");
   // Best rank first; ties broken by position so the order never depends on the input order.
-  std::stable_sort(hypotheses.begin(), hypotheses.end(), [&](const Hypothesis& a, const Hypothesis& b) {
-    const float ra = nmsRank(a, banks, params), rb = nmsRank(b, banks, params);
-    return std::tie(rb, a.bank, a.y, a.x) < std::tie(ra, b.bank, b.y, b.x);
-  });
-  std::vector<Hypothesis> kept;
+  // The ranks are computed once, not per comparison.
+  std::vector<std::pair<float, Hypothesis>> ranked;
+  ranked.reserve(hypotheses.size());
   for (auto& h : hypotheses) {
+    const float rank = nmsRank(h, banks, params);
+    ranked.emplace_back(rank, std::move(h));
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    return std::tie(b.first, a.second.bank, a.second.y, a.second.x) <
+           std::tie(a.first, b.second.bank, b.second.y, b.second.x);
+  });
+  const auto isSmallPart = [&](const Hypothesis& h) {
+    return banks[static_cast<std::size_t>(h.bank)].diameter < kSmallPartDiameterM;
+  };
+  std::vector<Hypothesis> kept;
+  for (auto& [rank, h] : ranked) {
     bool suppressed = false;
     for (const auto& k : kept) {
       if (!params.across_objects && k.bank != h.bank) continue;
+      // Within one small part only: across objects, one place holds one object.
+      const float fraction = k.bank == h.bank && isSmallPart(h) ? params.small_part_radius_fraction
+                                                                : params.radius_fraction;
       const float r = params.radius_px > 0.f ? params.radius_px
-                                             : params.radius_fraction * std::max(projectedDiameter(h, banks, fx),
-                                                                                 projectedDiameter(k, banks, fx));
+                                             : fraction * std::max(projectedDiameter(h, banks, fx),
+                                                                   projectedDiameter(k, banks, fx));
       const float dx = h.x - k.x, dy = h.y - k.y;
       if (dx * dx + dy * dy < r * r) {
         suppressed = true;

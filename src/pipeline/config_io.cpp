@@ -38,11 +38,13 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"nms", "radius_px", "suppression radius, pixels (0: radius_fraction of the object's size)", &p.nms.radius_px},
       {"nms", "radius_fraction", "suppression radius, share of the larger projected diameter", &p.nms.radius_fraction},
       {"nms", "template_weight", "parts under 10 cm: rank by gamma * (templates in the cluster)^w (0: gamma alone)", &p.nms.template_weight},
+      {"nms", "small_part_radius_fraction", "parts under 10 cm, with poses: suppression radius within the part, share of its projected diameter", &p.nms.small_part_radius_fraction},
       {"nms", "across_objects", "suppress across objects too (without poses)", &p.nms.across_objects},
       {"detector", "estimate_poses", "run stages 6-8 (false: stop after NMS)", &p.estimate_poses},
       {"detector", "min_score", "without poses: smallest cluster score gamma, 0..1", &p.min_score},
       {"detector", "pose_min_score", "smallest gamma a hypothesis needs for a pose, 0..1", &p.pose_min_score},
       {"detector", "pose_candidates_per_object", "hypotheses per object that get a pose", &p.pose_candidates_per_object},
+      {"detector", "small_part_pose_candidates", "hypotheses per part under 10 cm that get a pose", &p.small_part_pose_candidates},
       {"detector", "duplicate_fraction", "poses closer than this share of the diameter are one, 0..1",
        &p.duplicate_fraction},
       {"detector", "threads", "CPU threads for the pose stages (0: all cores)", &p.threads},
@@ -102,6 +104,8 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"verify", "look_alike_tolerance",
        "half-turns within this share of the diameter are refit and compared with the pose (0: off)",
        &p.verify.look_alike_tolerance},
+      {"verify", "small_part_look_alike_tolerance", "the same for parts under 10 cm (0.5: every half-turn)",
+       &p.verify.small_part_look_alike_tolerance},
       {"verify", "min_colour_agreement",
        "meshes with colours: the pose's rendered chromaticity must agree with the frame's this much (-1: off)",
        &p.verify.min_colour_agreement},
@@ -203,9 +207,12 @@ std::string configTable(const DetectorParams& params) {
   out += fmt::format(
       "\nParts smaller than {:g} cm are also ranked and started differently (their own settings; larger\n"
       "objects ignore them): nms.template_weight ranks their hypotheses by gamma x templates^w (a part a few\n"
-      "LINEMOD cells across misaligns its depth crops, so gamma alone prefers bare floor), and\n"
-      "initial_pose.small_part_starts starts each from that many rotation groups. `vkpose train --resting\n"
-      "auto` (the default) trains every resting pose of such a part.\n",
+      "LINEMOD cells across misaligns its depth crops, so gamma alone prefers bare floor),\n"
+      "nms.small_part_radius_fraction narrows their NMS (the right view often sits in the cluster next to\n"
+      "a look-alike one; verification removes the duplicates), detector.small_part_pose_candidates of them\n"
+      "get a pose, initial_pose.small_part_starts starts each from that many rotation groups, and\n"
+      "verify.small_part_look_alike_tolerance turns each accepted pose over and keeps the better fit.\n"
+      "`vkpose train --resting auto` (the default) trains every resting pose of such a part.\n",
       100 * kSmallPartDiameterM);
   return out;
 }

@@ -112,14 +112,16 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   // Look-alike half-turns: about 0.1 s a mesh, so found here rather than stored (banks of
   // every version get them, and the tolerance stays a detection setting).
   look_alike_turns_.assign(banks_.size(), {});
-  if (params_.verify.resolve_symmetries && params_.verify.look_alike_tolerance > 0.f)
+  if (params_.verify.resolve_symmetries)
     util::parallelFor(
         banks_.size(),
         [&](std::size_t b) {
           const TemplateBank& bank = banks_[b];
           if (bank.symmetric) return;  // scored with ADI: turns do not count against it
           const float from = std::max(bank.params.near_symmetry_tolerance, 0.01f) * bank.diameter;
-          look_alike_turns_[b] = findLookAlikeTurns(bank.mesh, from, params_.verify.look_alike_tolerance * bank.diameter);
+          const float share = bank.diameter < kSmallPartDiameterM ? params_.verify.small_part_look_alike_tolerance
+                                                                  : params_.verify.look_alike_tolerance;
+          look_alike_turns_[b] = findLookAlikeTurns(bank.mesh, from, share * bank.diameter);
         },
         params_.threads);
 }
@@ -221,10 +223,16 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
     hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, nms);
     std::vector<int> taken(banks_.size(), 0);
     std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
-      return taken[static_cast<std::size_t>(h.bank)]++ >= params_.pose_candidates_per_object;
+      const auto b = static_cast<std::size_t>(h.bank);
+      const int most = banks_[b].diameter < kSmallPartDiameterM ? params_.small_part_pose_candidates
+                                                                 : params_.pose_candidates_per_object;
+      return taken[b]++ >= most;
     });
   } else {
-    hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, params_.nms);
+    // No verification to remove a small part's duplicates: one hypothesis a place for all.
+    NmsParams nms = params_.nms;
+    nms.small_part_radius_fraction = nms.radius_fraction;
+    hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, nms);
   }
   result.timings_ms.emplace_back("nms", msSince(t0));
 

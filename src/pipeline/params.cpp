@@ -87,9 +87,9 @@ void validateVerifyParams(const VerifyParams& params) {
     throw InputError(fmt::format("the shared support must be in [0, 1], got {}", params.max_shared_support));
   if (!(params.symmetry_margin >= 0.f && params.symmetry_margin <= 1.f))
     throw InputError(fmt::format("the symmetry margin must be in [0, 1], got {}", params.symmetry_margin));
-  if (!(params.look_alike_tolerance >= 0.f && params.look_alike_tolerance <= 0.5f))
-    throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}",
-                                 params.look_alike_tolerance));
+  for (const float tolerance : {params.look_alike_tolerance, params.small_part_look_alike_tolerance})
+    if (!(tolerance >= 0.f && tolerance <= 0.5f))
+      throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}", tolerance));
   if (!(params.min_contour_edges >= 0.f && params.min_contour_edges <= 1.f))
     throw InputError(fmt::format("the contour edge share must be in [0, 1], got {}", params.min_contour_edges));
   if (!(params.min_colour_agreement >= -1.f && params.min_colour_agreement <= 1.f))
@@ -161,8 +161,8 @@ void validateDetectorParams(const DetectorParams& p) {
   if (p.cluster.position_step_px < 1 || p.cluster.min_templates < 1)
     throw InputError(fmt::format("the clustering cell ({} px) and the smallest cluster ({} templates) must be 1 or more",
                                  p.cluster.position_step_px, p.cluster.min_templates));
-  if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f))
-    throw InputError("the NMS radius must be 0 or more pixels and its fraction more than 0");
+  if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f) || !(p.nms.small_part_radius_fraction > 0.f))
+    throw InputError("the NMS radius must be 0 or more pixels and its fractions more than 0");
   if (!(p.nms.template_weight >= 0.f && p.nms.template_weight <= 4.f))
     throw InputError(fmt::format("the NMS template weight must be in [0, 4], not {}", p.nms.template_weight));
   validateScoreParams(p.score);
@@ -170,6 +170,8 @@ void validateDetectorParams(const DetectorParams& p) {
   if (!(p.pose_min_score >= 0.f && p.pose_min_score <= 1.f)) throw InputError("minimum pose score must be in [0, 1]");
   if (p.pose_candidates_per_object < 1)
     throw InputError(fmt::format("pose candidates per object must be at least 1, not {}", p.pose_candidates_per_object));
+  if (p.small_part_pose_candidates < 1)
+    throw InputError(fmt::format("pose candidates per small part must be at least 1, not {}", p.small_part_pose_candidates));
   validateInitialPoseParams(p.initial_pose);
   validateRefineParams(p.refine);
   validateVerifyParams(p.verify);
