@@ -225,6 +225,12 @@ struct TrainingParams {
 /// Throws InputError naming the bad value.
 void validateTrainingParams(const TrainingParams& params);
 
+/// What a user should know before training `mesh` with `params`, one sentence each (empty:
+/// nothing): today, an object under about 2.5 cells of LINEMOD's coarsest level across at the
+/// farthest training distance, whose views give too few features. `vkpose train` prints them,
+/// vkpose.train() raises them as Python warnings.
+std::vector<std::string> trainingWarnings(const Mesh& mesh, const TrainingParams& params);
+
 /// Depth and normals of a rendered template, sampled every `stride` pixels over the object's
 /// box: cell (i, j) is template pixel (x0 + j * stride, y0 + i * stride) (level 0, relative
 /// to the template's top-left corner; x0, y0 <= 0 when the object reaches past the features).

@@ -234,9 +234,14 @@ void bindCore(py::module_& m) {
         const std::string cache = cache_dir.is_none() ? std::string() : pathOf(cache_dir, "cache_dir");
         const MeshUnits mesh_units = parseMeshUnits(units);
         const std::shared_ptr<Device> dev = deviceOf(device);
+        const Mesh mesh = [&] {
+          py::gil_scoped_release nogil;
+          return loadMesh(path, mesh_units);
+        }();
+        for (const std::string& w : trainingWarnings(mesh, params))
+          if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
         const auto report = progressOf(progress, "training");
         py::gil_scoped_release nogil;
-        const Mesh mesh = loadMesh(path, mesh_units);
         const UpAxisChoice choice = findUpAxis(mesh);
         if (up == "auto") params.views.up = choice.up;
         if (trainsOtherRestingPoses(resting, mesh.diameter) && !params.views.full_sphere)

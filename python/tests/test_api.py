@@ -160,6 +160,17 @@ def test_training_checks_its_arguments_before_any_work(tmp_path):
         vkpose.train(mesh, resting="sideways")
 
 
+def test_training_warns_when_the_object_is_too_small_for_linemod():
+    # The demo's bracket (136 mm) at 4 m: 20 pixels, 0.5 cells of the coarse level. Training may
+    # then find too few features in every view; either way the warning came first.
+    mesh = REPO / "assets" / "meshes" / "angle_bracket.ply"
+    with pytest.warns(UserWarning, match="cells of LINEMOD's coarsest level"):
+        try:
+            vkpose.train(mesh, units="mm", views=2, radii=4.0, inplane=0)
+        except ValueError:
+            pass
+
+
 def test_training_finds_the_up_axis(meshes):
     small = dict(views=2, radii=0.6, inplane=0)
     milk = vkpose.train(meshes / "milk.stl", units="m", **small)

@@ -101,20 +101,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                    unitName(report.units), report.file_diameter);
       fmt::print("diameter: {:.4f} m\n", mesh.diameter);
     }
-    // LINEMOD's coarsest level sees the object at 1 / 2^(levels - 1) of the resolution, in
-    // cells of T pixels: below about 2.5 cells across, its views give few features and
-    // detection falls off (docs/evaluation.md: a 20 mm part at 0.3-0.45 m, 1.6-2.4 cells,
-    // F1 0.31; 40 mm, 3.2-4.8 cells, 0.45-0.76; LM-O's ape at 1.3 m, 2.8 cells).
-    const std::vector<int>& T = params.features.T;
-    const double far = std::max(params.views.radii.from, params.views.radii.to);
-    const double pixels = 0.5 * (params.camera.fx + params.camera.fy) * mesh.diameter / far;
-    const double cells = T.empty() ? 0.0 : pixels / (static_cast<double>(1 << (T.size() - 1)) * T.back());
-    if (!T.empty() && cells < 2.5)
-      fmt::print(stderr,
-                 "vkpose: warning: {:.0f} mm across at {:.2f} m is {:.0f} pixels, {:.1f} cells of LINEMOD's coarsest "
-                 "level (T = {}): below about 2.5 cells, many views give too few features and detection falls off; "
-                 "train (and detect) nearer, or with a longer focal length\n",
-                 1e3 * mesh.diameter, far, pixels, cells, T.back());
+    for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
     const UpAxisChoice up = findUpAxis(mesh);
     if (opt->up == "auto") {
       params.views.up = up.up;
