@@ -291,8 +291,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
       rendered.push_back(poseOnViewingRay(R, h, bank, camera, params_.initial_pose.range_along_ray));
     };
     start(rot.R, rot.group_size);
-    for (std::size_t k = 0; k < rot.more.size(); ++k) start(rot.more[k], rot.more_sizes[k]);
-    if (rot.by_fit) start(*rot.by_fit, rot.by_fit_size);
+    for (const RotationStart& s : rot.more) start(s.R, s.votes);
+    if (rot.by_fit) start(rot.by_fit->R, rot.by_fit->votes);
   }
   const std::size_t n = hypotheses.size();
   if (renderers_.empty()) {

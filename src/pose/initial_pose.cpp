@@ -86,8 +86,7 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
   out.R = groups.front().mean;
   out.group_size = static_cast<int>(groups.front().members.size());
   for (std::size_t g = 1; g < groups.size() && g < static_cast<std::size_t>(std::max(starts, 1)); ++g) {
-    out.more.push_back(groups[g].mean);
-    out.more_sizes.push_back(static_cast<int>(groups[g].members.size()));
+    out.more.push_back({groups[g].mean, static_cast<int>(groups[g].members.size())});
   }
   if (!params.second_start_by_fit) return out;
   // The scored members again, each weighted by its own fit to the scene (stage 4's), groups
@@ -106,10 +105,9 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
   const auto best = std::max_element(by_fit.begin(), by_fit.end(),
                                      [](const RotationGroup& a, const RotationGroup& b) { return a.weight < b.weight; });
   if (rotationDistance(best->mean, out.R) <= tau) return out;
-  for (const Eigen::Matrix3f& R : out.more)
-    if (rotationDistance(best->mean, R) <= tau) return out;
-  out.by_fit = best->mean;
-  out.by_fit_size = static_cast<int>(best->members.size());
+  for (const RotationStart& s : out.more)
+    if (rotationDistance(best->mean, s.R) <= tau) return out;
+  out.by_fit = RotationStart{best->mean, static_cast<int>(best->members.size())};
   return out;
 }
 

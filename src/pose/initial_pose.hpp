@@ -44,18 +44,22 @@ struct RotationGroup {
 std::vector<RotationGroup> clusterRotations(const std::vector<Eigen::Matrix3f>& rotations, float max_angle_rad,
                                             const std::vector<float>& weights = {});
 
+/// A rotation group stage 6 starts from: its mean and how many templates voted for it.
+struct RotationStart {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera
+  int votes = 0;                                     ///< templates in the group
+};
+
 struct InitialRotation {
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();  ///< object-to-camera
   int group_size = 0;  ///< templates in the chosen group
   int candidates = 0;  ///< templates of the hypothesis
-  /// InitialPoseParams::second_start_by_fit: the mean of the group whose members' stage-4 fit
-  /// sums highest, when that is not the largest group (farther than tau_theta from R).
-  std::optional<Eigen::Matrix3f> by_fit;
-  int by_fit_size = 0;  ///< templates in that group
-  /// With `starts` > 1: the means of the next largest groups, largest first, up to starts - 1
-  /// (by_fit is left out when it is one of them), and their sizes.
-  std::vector<Eigen::Matrix3f> more;
-  std::vector<int> more_sizes;
+  /// InitialPoseParams::second_start_by_fit: the group whose members' stage-4 fit sums
+  /// highest, when that is not the largest group (farther than tau_theta from R).
+  std::optional<RotationStart> by_fit;
+  /// With `starts` > 1: the next largest groups, largest first, up to starts - 1 (by_fit is
+  /// left out when it is one of them).
+  std::vector<RotationStart> more;
 };
 
 /// Stage 6, rotation: every member's template rotation is turned onto the viewing ray through
