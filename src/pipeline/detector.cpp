@@ -35,6 +35,12 @@ using util::msSince;
 constexpr float kTwinDistance = 0.05f;
 constexpr float kTwinAngleRad = 0.0873f;  // 5 degrees
 
+/// A verified pose's score: the collision rate, times the share not seen through, times the
+/// outline's support (Detection::score).
+float poseScore(float collision_rate, float see_through, float silhouette_support) {
+  return collision_rate * (1.f - see_through) * silhouette_support;
+}
+
 bool sameFeatures(const FeatureParams& a, const FeatureParams& b) {
   return a.T == b.T && a.use_colour == b.use_colour && a.use_depth == b.use_depth;
 }
@@ -408,10 +414,10 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   // candidates x 4 starts converge on a few instances). The duplicate test below would drop
   // them anyway; dropping them here spares each its renderings and refits, which were most
   // of a bracket bin frame (4.6 of 10.4 s).
-  std::vector<int> twin_of(n, -1);
+  std::vector<char> twin(n, 0);
   {
     const auto preliminary = [&](std::size_t i) {
-      return verified[i].collision_rate * (1.f - agreement[i].seen_through) * support[i];
+      return poseScore(verified[i].collision_rate, agreement[i].seen_through, support[i]);
     };
     std::vector<std::size_t> order;
     for (std::size_t i = 0; i < n; ++i)
@@ -428,21 +434,22 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
             (p.R * banks_[b].centre + p.t - q.R * banks_[b].centre - q.t).norm() > kTwinDistance * banks_[b].diameter ||
             Eigen::AngleAxisf(p.R.transpose() * q.R).angle() > kTwinAngleRad)
           continue;
-        twin_of[i] = static_cast<int>(k);
+        twin[i] = 1;
         break;
       }
-      if (twin_of[i] < 0) kept.push_back(i);
+      if (!twin[i]) kept.push_back(i);
     }
   }
-  // Hopeless: a pose whose outline shows under half the depth step the test asks for is not
-  // saved by a turn (a turn keeps most of the outline); its renderings are spared too.
+  // Hopeless: a pose whose outline shows under a fifth of the depth step the test asks for;
+  // its renderings and refits are spared too. Not more than a fifth: turned over, a bracket's
+  // outline changes enough that at half of it a correct detection was lost (docs/pipeline.md).
   const auto hopeless = [&](std::size_t i) {
     return support[i] < 0.2f * verify_params[i].min_silhouette_support;
   };
   for (std::size_t i = 0; i < n; ++i) {
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
     const auto& symmetries = banks_[b].near_symmetries;
-    if (!initial[i].ok || !verified[i].accepted || twin_of[i] >= 0 || hopeless(i)) continue;
+    if (!initial[i].ok || !verified[i].accepted || twin[i] || hopeless(i)) continue;
     Detection& d = dets[i];
     const bool resolve = params_.verify.resolve_symmetries && !symmetries.empty();
     if (!colourful_[b] && resolve) {
@@ -511,7 +518,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   for (std::size_t i = 0; i < n; ++i) {
     const auto b = static_cast<std::size_t>(hypotheses[i].bank);
     const auto& turns = look_alike_turns_[b];
-    if (turns.empty() || !initial[i].ok || !verified[i].accepted || twin_of[i] >= 0 || hopeless(i)) continue;
+    if (turns.empty() || !initial[i].ok || !verified[i].accepted || twin[i] || hopeless(i)) continue;
     const auto windowOf = [&](const std::vector<Pose>& poses) {
       cv::Rect window;
       for (const auto& p : poses) window |= projectedWindow(p, banks_[b].centre, bounding_radius_[b], camera);
@@ -610,10 +617,10 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     d.depth_fit = agreement[i].fits;
     d.silhouette_support = support[i];
     d.contour_edges = contour[i];
-    d.score = d.collision_rate * (1.f - d.see_through) * d.silhouette_support;
+    d.score = poseScore(d.collision_rate, d.see_through, d.silhouette_support);
     placeInImage(d, initial[i].model_points, bank.centre, camera);
     const VerifyParams& vp = verify_params[i];
-    if (twin_of[i] >= 0)
+    if (twin[i])
       d.rejection = fmt::format("the same pose as a better {} candidate", bank.object);
     else if (!verified[i].accepted)
       d.rejection = fmt::format("collision rate {:.2f} is not above {:.2f}", d.collision_rate, vp.threshold);
