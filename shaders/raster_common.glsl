@@ -18,13 +18,21 @@ const float kSubpixel = 8.0;      // fixed point: 1/8 pixel
 const float kNearZ = 1e-3;        // metres: triangles closer than this are dropped
 const float kGuardPx = 1048576.0; // screen coordinates beyond this are dropped
 
+// Edge functions are exact integers. In 32 bits when the triangle spans less than
+// kNarrowExtent in x and y: every difference is then below 2^14 and every product below 2^28
+// (pixels tested lie in the triangle's box). Wider triangles (2,048 px and more) take 64 bits.
+// The two give the same integers; lavapipe runs 64-bit integer vectors lane by lane, and in
+// 64 bits throughout the triangle setup cost 5 times as much.
+const int kNarrowExtent = 16384;  // fixed point: 2,048 px
+
+// No arrays in it: lavapipe kept a struct with arrays in scratch memory, lane by lane.
 struct Triangle {
-  vec3 p[3];        // camera frame, metres
-  i64vec2 s[3];     // screen, fixed point
-  int64_t area;     // twice the signed area, fixed point, made positive
-  int64_t sign;     // +1 or -1: the winding
+  ivec2 s0, s1, s2; // screen, fixed point (within the guard band: below 2^23)
+  bool wide;        // spans kNarrowExtent or more: edge functions in 64 bits
+  float area;       // twice the signed area, fixed point, made positive (an integer)
+  float sign;       // +1 or -1: the winding
   ivec4 box;        // inclusive pixel bounds, clipped to the image
-  float rz[3];      // 1 / z per vertex
+  vec3 rz;          // 1 / z per vertex
   vec3 n;           // plane normal (unnormalized), camera frame
   float n_p0;       // dot(n, p[0])
   vec2 zrange;      // nearest and farthest vertex depth
@@ -36,48 +44,68 @@ vec3 toCamera(uint view, vec3 v) {
   return c;
 }
 
-int64_t floorDiv8(int64_t a) { return a >= 0 ? a / 8 : -((-a + 7) / 8); }
+int floorDiv8(int a) { return a >= 0 ? a / 8 : -((-a + 7) / 8); }
 
-int64_t edgeFunction(i64vec2 a, i64vec2 b, i64vec2 p) {
-  return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+// The edge function as a float: the integer's sign and its rounding to float are those of
+// the 64-bit value the C++ twin computes.
+float edgeFunction(bool wide, ivec2 a, ivec2 b, ivec2 p) {
+  if (wide)
+    return float(int64_t(b.x - a.x) * int64_t(p.y - a.y) - int64_t(b.y - a.y) * int64_t(p.x - a.x));
+  return float((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x));
+}
+
+// One corner: camera point, 1 / z and the fixed-point screen position; false when it lies
+// nearer than kNearZ or beyond the guard band (then the other outputs mean nothing).
+bool projectCorner(uint view, uint vertex, out vec3 p, out float rz_out, out ivec2 s) {
+  p = toCamera(view, vertices[vertex].xyz);
+  precise float rz = 1.0 / p.z;
+  precise float sx = pc.fx * (p.x * rz) + pc.cx;
+  precise float sy = pc.fy * (p.y * rz) + pc.cy;
+  rz_out = rz;
+  s = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
+  return p.z > kNearZ && abs(sx) < kGuardPx && abs(sy) < kGuardPx;
 }
 
 bool setupTriangle(uint view, uint f, out Triangle t) {
   uvec4 idx = faces[f];
-  t.area = 0;
-  t.sign = 1;
+  t.area = 0.0;
+  t.sign = 1.0;
   t.box = ivec4(0, 0, -1, -1);
-  for (int i = 0; i < 3; ++i) {
-    t.p[i] = toCamera(view, vertices[idx[i]].xyz);
-    if (!(t.p[i].z > kNearZ)) return false;
-    precise float rz = 1.0 / t.p[i].z;
-    precise float sx = pc.fx * (t.p[i].x * rz) + pc.cx;
-    precise float sy = pc.fy * (t.p[i].y * rz) + pc.cy;
-    if (!(abs(sx) < kGuardPx && abs(sy) < kGuardPx)) return false;
-    t.rz[i] = rz;
-    t.s[i] = i64vec2(int64_t(floor(sx * kSubpixel + 0.5)), int64_t(floor(sy * kSubpixel + 0.5)));
-  }
-  int64_t area = edgeFunction(t.s[0], t.s[1], t.s[2]);
-  if (area == 0) return false;
-  precise vec3 n = cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-  precise float n_p0 = dot(n, t.p[0]);
+  // Three calls, not a loop over arrays: see Triangle.
+  vec3 p0, p1, p2;
+  float rz0, rz1, rz2;
+  ivec2 s0, s1, s2;
+  const bool ok0 = projectCorner(view, idx.x, p0, rz0, s0);
+  const bool ok1 = projectCorner(view, idx.y, p1, rz1, s1);
+  const bool ok2 = projectCorner(view, idx.z, p2, rz2, s2);
+  if (!(ok0 && ok1 && ok2)) return false;
+  t.rz = vec3(rz0, rz1, rz2);
+  t.s0 = s0;
+  t.s1 = s1;
+  t.s2 = s2;
+  const ivec2 lo = min(s0, min(s1, s2)), hi = max(s0, max(s1, s2));
+  t.wide = hi.x - lo.x >= kNarrowExtent || hi.y - lo.y >= kNarrowExtent;
+  const float area = edgeFunction(t.wide, s0, s1, s2);
+  if (area == 0.0) return false;
+  precise vec3 n = cross(p1 - p0, p2 - p0);
+  precise float n_p0 = dot(n, p0);
   t.n = n;
   t.n_p0 = n_p0;
-  t.zrange = vec2(min(t.p[0].z, min(t.p[1].z, t.p[2].z)), max(t.p[0].z, max(t.p[1].z, t.p[2].z)));
-  t.sign = area > 0 ? 1 : -1;
+  t.zrange = vec2(min(p0.z, min(p1.z, p2.z)), max(p0.z, max(p1.z, p2.z)));
+  t.sign = area > 0.0 ? 1.0 : -1.0;
   t.area = area * t.sign;
-  int64_t x0 = min(t.s[0].x, min(t.s[1].x, t.s[2].x)), x1 = max(t.s[0].x, max(t.s[1].x, t.s[2].x));
-  int64_t y0 = min(t.s[0].y, min(t.s[1].y, t.s[2].y)), y1 = max(t.s[0].y, max(t.s[1].y, t.s[2].y));
-  // Pixel centres sit on integer coordinates (OpenCV's convention): x0 / 8 rounded up.
-  t.box = ivec4(int(max(-floorDiv8(-x0), int64_t(0))), int(max(-floorDiv8(-y0), int64_t(0))),
-                int(min(floorDiv8(x1), int64_t(pc.width - 1))), int(min(floorDiv8(y1), int64_t(pc.height - 1))));
+  // Pixel centres sit on integer coordinates (OpenCV's convention): lo / 8 rounded up.
+  t.box = ivec4(max(-floorDiv8(-lo.x), 0), max(-floorDiv8(-lo.y), 0), min(floorDiv8(hi.x), pc.width - 1),
+                min(floorDiv8(hi.y), pc.height - 1));
   return t.box.x <= t.box.z && t.box.y <= t.box.w;
 }
 
-// Screen-space barycentric numerators at pixel (x, y); all >= 0 inside (edges included).
-i64vec3 edgesAt(Triangle t, int x, int y) {
-  i64vec2 p = i64vec2(int64_t(x) * 8, int64_t(y) * 8);
-  return i64vec3(edgeFunction(t.s[1], t.s[2], p), edgeFunction(t.s[2], t.s[0], p), edgeFunction(t.s[0], t.s[1], p)) *
+// Screen-space barycentric numerators at pixel (x, y) of the triangle's box, as floats; all
+// >= 0 inside (edges included).
+vec3 edgesAt(Triangle t, int x, int y) {
+  ivec2 p = ivec2(x * 8, y * 8);
+  return vec3(edgeFunction(t.wide, t.s1, t.s2, p), edgeFunction(t.wide, t.s2, t.s0, p),
+              edgeFunction(t.wide, t.s0, t.s1, p)) *
          t.sign;
 }
 

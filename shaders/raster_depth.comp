@@ -15,8 +15,8 @@ void main() {
   uint base = view * uint(pc.width * pc.height);
   for (int y = t.box.y; y <= t.box.w; ++y)
     for (int x = t.box.x; x <= t.box.z; ++x) {
-      i64vec3 e = edgesAt(t, x, y);
-      if (e.x < 0 || e.y < 0 || e.z < 0) continue;
+      vec3 e = edgesAt(t, x, y);
+      if (e.x < 0.0 || e.y < 0.0 || e.z < 0.0) continue;
       float z = depthAt(t, x, y);
       // Positive floats order like their bit patterns.
       atomicMin(raster[base + uint(y * pc.width + x)], (uint64_t(floatBitsToUint(z)) << 32) | uint64_t(f));

@@ -30,11 +30,10 @@ void main() {
   Triangle t;
   setupTriangle(view, f, t);
   int y = int(i) / pc.width, x = int(i) - y * pc.width;
-  i64vec3 e = edgesAt(t, x, y);
+  vec3 e = edgesAt(t, x, y);
   precise float z = uintBitsToFloat(uint(key >> 32));
-  precise float inv_area = 1.0 / float(t.area);
-  precise vec3 w = vec3(float(e.x) * inv_area * t.rz[0] * z, float(e.y) * inv_area * t.rz[1] * z,
-                        float(e.z) * inv_area * t.rz[2] * z);
+  precise float inv_area = 1.0 / t.area;
+  precise vec3 w = vec3(e.x * inv_area * t.rz.x * z, e.y * inv_area * t.rz.y * z, e.z * inv_area * t.rz.z * z);
   uvec4 idx = faces[f];
   precise vec3 n;
   if ((pc.flags & 1u) != 0u) {

@@ -84,6 +84,39 @@ TEST(Render, GpuMatchesReferenceOnTheCoffeeCupAndAColouredPly) {
   }
 }
 
+// The rasterizer's edge functions run in 32 bits for triangles under 2,048 px across and in
+// 64 bits for wider ones (raster_common.glsl); the C++ reference is 64-bit throughout. A 2 m
+// box seen from 2 cm off one face has triangles of tens of thousands of pixels, whose edge
+// functions would overflow 32 bits.
+TEST(Render, TrianglesWiderThanTwoThousandPixelsMatchTheReference) {
+  const Mesh box = test::boxMesh({2.f, 2.f, 2.f});
+  MeshRenderer renderer(test::context(), box);
+  const Camera cam = smallCamera();
+  Pose pose;
+  pose.R = Eigen::AngleAxisf(0.01f, Eigen::Vector3f(1.f, 0.5f, 0.f).normalized()).toRotationMatrix();
+  pose.t = Eigen::Vector3f(0.1f, -0.05f, 1.03f);  // the near face is 2-3 cm from the camera
+  const Rendering gpu = renderer.render(cam, {pose})[0];
+  const Rendering ref = renderReference(box, cam, pose);
+  int wide = 0;  // faces wider than 8,192 px in the image (all corners in front of the camera)
+  for (const Eigen::Vector3i& f : box.faces) {
+    float lo = 1e30f, hi = -1e30f;
+    bool front = true;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f c = pose.R * box.vertices[static_cast<std::size_t>(f[k])] + pose.t;
+      front = front && c.z() > 1e-3f;
+      const float x = static_cast<float>(cam.fx) * c.x() / c.z();
+      lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+    wide += front && hi - lo > 8192.f;
+  }
+  ASSERT_GE(wide, 1) << "the pose must put a wide triangle in front of the camera";
+  ASSERT_GT(cv::countNonZero(ref.mask()), 1000);
+  const Agreement g = compare(gpu, ref);
+  EXPECT_GE(g.mask_agree, 0.9995);
+  EXPECT_LE(g.max_depth_rel, 1e-5f);
+  EXPECT_GE(g.min_normal_dot, 0.999f);
+}
+
 /// Distance along the pixel's ray (z) to an axis-aligned box under `pose`, or 0 for a miss.
 float rayCastBox(const Camera& cam, const Pose& pose, const Eigen::Vector3f& half, int x, int y) {
   const Eigen::Vector3f ray_cam((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);
