@@ -12,6 +12,7 @@
 #include "hypotheses/cluster_score_math.hpp"
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
+#include "pipeline/pipeline.hpp"
 #include "synth/scene.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"
@@ -406,6 +407,53 @@ TEST(Detector, FindsEachInstanceOfASyntheticSceneOnceAndNothingElse) {
     EXPECT_NE(std::find(stages.begin(), stages.end(), "scoring"), stages.end());
     EXPECT_EQ(stages.back(), "total");
   }
+}
+
+// Stage 8's duplicate test within one object (rejectSameObjectDuplicates): a small part
+// turned over a real one fills the same cells and outline, so it may score higher, but it
+// sits off the scene over the whole mask; the dense fit of the look-alike check decides.
+// Another object's pose in the same place is left to the score (the caller's second pass),
+// and poses further apart than duplicate_fraction of the diameter both stay.
+TEST(Detector, OfTwoPosesOfOneObjectInOnePlaceTheDenseFitDecides) {
+  TemplateBank part, other;
+  part.object = "part";
+  part.diameter = 0.04f;
+  part.centre = Eigen::Vector3f(0.f, 0.f, 0.005f);
+  other.object = "other";
+  other.diameter = 0.2f;
+  const auto pose = [](float x) {
+    Detection d;
+    d.pose.t = Eigen::Vector3f(x, 0.f, 0.4f);
+    d.object = "part";
+    d.verified = true;
+    return d;
+  };
+  const auto withFit = [](Detection d, float score, float fit) {
+    d.score = score;
+    d.look_alike_alternatives.resize(2);
+    d.look_alike_chosen = 1;
+    d.look_alike_alternatives[1].score = fit;
+    return d;
+  };
+  Detection turned_over = withFit(pose(0.f), 0.65f, 0.35f), right = withFit(pose(0.004f), 0.47f, 0.63f);
+  Detection elsewhere = withFit(pose(0.05f), 0.9f, 0.9f);
+  Detection other_object = pose(0.002f);
+  other_object.bank = 1;
+  other_object.object = "other";
+  other_object.score = 0.3f;
+  std::vector<Detection> verified = {turned_over, right, elsewhere, other_object};
+  rejectSameObjectDuplicates(verified, {part, other}, 0.3f);
+  EXPECT_EQ(verified[0].rejection, "the same place as a better part detection");
+  EXPECT_TRUE(verified[1].rejection.empty());
+  EXPECT_TRUE(verified[2].rejection.empty());
+  EXPECT_TRUE(verified[3].rejection.empty()) << "another object is the caller's to decide";
+  // Without the look-alike check's fit the score alone decides.
+  verified = {pose(0.f), pose(0.004f)};
+  verified[0].score = 0.65f;
+  verified[1].score = 0.47f;
+  rejectSameObjectDuplicates(verified, {part, other}, 0.3f);
+  EXPECT_TRUE(verified[0].rejection.empty());
+  EXPECT_EQ(verified[1].rejection, "the same place as a better part detection");
 }
 
 TEST(Detector, RejectsFramesItCannotUse) {

@@ -109,7 +109,7 @@ float projectedDiameter(const Hypothesis& h, const std::vector<TemplateBank>& ba
 }
 
 float nmsRank(const Hypothesis& h, const std::vector<TemplateBank>& banks, const NmsParams& params) {
-  if (params.template_weight == 0.f || !(banks[static_cast<std::size_t>(h.bank)].diameter < kSmallPartDiameterM))
+  if (params.template_weight == 0.f || !isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter))
     return h.score;
   return h.score * std::pow(static_cast<float>(h.members.size()), params.template_weight);
 }
@@ -130,8 +130,8 @@ std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, co
     return std::tie(b.first, a.second.bank, a.second.y, a.second.x) <
            std::tie(a.first, b.second.bank, b.second.y, b.second.x);
   });
-  const auto isSmallPart = [&](const Hypothesis& h) {
-    return banks[static_cast<std::size_t>(h.bank)].diameter < kSmallPartDiameterM;
+  const auto smallPart = [&](const Hypothesis& h) {
+    return isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter);
   };
   std::vector<Hypothesis> kept;
   for (auto& [rank, h] : ranked) {
@@ -139,7 +139,7 @@ std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, co
     for (const auto& k : kept) {
       if (!params.across_objects && k.bank != h.bank) continue;
       // Within one small part only: across objects, one place holds one object.
-      const float fraction = k.bank == h.bank && isSmallPart(h) ? params.small_part_radius_fraction
+      const float fraction = k.bank == h.bank && smallPart(h) ? params.small_part_radius_fraction
                                                                 : params.radius_fraction;
       const float r = params.radius_px > 0.f ? params.radius_px
                                              : fraction * std::max(projectedDiameter(h, banks, fx),

@@ -109,6 +109,8 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"verify", "min_colour_agreement",
        "meshes with colours: the pose's rendered chromaticity must agree with the frame's this much (-1: off)",
        &p.verify.min_colour_agreement},
+      {"verify", "small_part_min_colour_agreement", "the same for parts under 10 cm (their depth tests say less)",
+       &p.verify.small_part_min_colour_agreement},
       {"sensor", "axial_sigma_at_1m", "depth noise sigma(z) = this * z^2, metres at 1 m", &p.sensor.axial_sigma_at_1m},
       {"sensor", "quantization_m", "the depth images' step, metres", &p.sensor.quantization_m},
       {"detector", "scale_lengths", "lengths left at their defaults follow each object's size and the sensor's noise",
@@ -211,7 +213,8 @@ std::string configTable(const DetectorParams& params) {
       "nms.small_part_radius_fraction narrows their NMS (the right view often sits in the cluster next to\n"
       "a look-alike one; verification removes the duplicates), detector.small_part_pose_candidates of them\n"
       "get a pose, initial_pose.small_part_starts starts each from that many rotation groups, and\n"
-      "verify.small_part_look_alike_tolerance turns each accepted pose over and keeps the better fit.\n"
+      "verify.small_part_look_alike_tolerance turns each accepted pose over and keeps the better fit, and\n"
+      "verify.small_part_min_colour_agreement asks more of their colour (their depth tests say less).\n"
       "`vkpose train --resting auto` (the default) trains every resting pose of such a part.\n",
       100 * kSmallPartDiameterM);
   return out;

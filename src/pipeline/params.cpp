@@ -92,8 +92,9 @@ void validateVerifyParams(const VerifyParams& params) {
       throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}", tolerance));
   if (!(params.min_contour_edges >= 0.f && params.min_contour_edges <= 1.f))
     throw InputError(fmt::format("the contour edge share must be in [0, 1], got {}", params.min_contour_edges));
-  if (!(params.min_colour_agreement >= -1.f && params.min_colour_agreement <= 1.f))
-    throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", params.min_colour_agreement));
+  for (const float agreement : {params.min_colour_agreement, params.small_part_min_colour_agreement})
+    if (!(agreement >= -1.f && agreement <= 1.f))
+      throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", agreement));
 }
 
 void validateSensorParams(const SensorParams& p) {

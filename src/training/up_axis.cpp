@@ -185,7 +185,7 @@ std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const E
 bool trainsOtherRestingPoses(const std::string& resting, float diameter_m) {
   if (resting == "all") return true;
   if (resting == "up") return false;
-  if (resting == "auto") return diameter_m < kSmallPartDiameterM;
+  if (resting == "auto") return isSmallPart(diameter_m);
   throw InputError(fmt::format("resting: '{}' is none of auto, all, up", resting));
 }
 
