@@ -140,7 +140,7 @@ std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, co
       if (!params.across_objects && k.bank != h.bank) continue;
       // Within one small part only: across objects, one place holds one object.
       const float fraction = k.bank == h.bank && smallPart(h) ? params.small_part_radius_fraction
-                                                                : params.radius_fraction;
+                                                              : params.radius_fraction;
       const float r = params.radius_px > 0.f ? params.radius_px
                                              : fraction * std::max(projectedDiameter(h, banks, fx),
                                                                    projectedDiameter(k, banks, fx));

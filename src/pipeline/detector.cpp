@@ -172,7 +172,7 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
           if (bank.symmetric) return;  // scored with ADI: turns do not count against it
           const float from = std::max(bank.params.near_symmetry_tolerance, 0.01f) * bank.diameter;
           const float share = isSmallPart(bank.diameter) ? params_.verify.small_part_look_alike_tolerance
-                                                                  : params_.verify.look_alike_tolerance;
+                                                         : params_.verify.look_alike_tolerance;
           look_alike_turns_[b] = findLookAlikeTurns(bank.mesh, from, share * bank.diameter);
         },
         params_.threads);
@@ -277,7 +277,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
     std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
       const auto b = static_cast<std::size_t>(h.bank);
       const int most = isSmallPart(banks_[b].diameter) ? params_.small_part_pose_candidates
-                                                                 : params_.pose_candidates_per_object;
+                                                        : params_.pose_candidates_per_object;
       return taken[b]++ >= most;
     });
   } else {
