@@ -21,11 +21,10 @@ const float kGuardPx = 1048576.0; // screen coordinates beyond this are dropped
 // Edge functions are exact integers. In 32 bits when the triangle spans less than
 // kNarrowExtent in x and y: every difference is then below 2^14 and every product below 2^28
 // (pixels tested lie in the triangle's box). Wider triangles (2,048 px and more) take 64 bits.
-// The two give the same integers; lavapipe runs 64-bit integer vectors lane by lane, and in
-// 64 bits throughout the triangle setup cost 5 times as much.
+// The two give the same integers; lavapipe runs 64-bit integer vectors lane by lane (with the
+// corners in 32 bits too, a stage-6 window of a 62k-face mesh 13.6 -> 9.7 ms).
 const int kNarrowExtent = 16384;  // fixed point: 2,048 px
 
-// No arrays in it: lavapipe kept a struct with arrays in scratch memory, lane by lane.
 struct Triangle {
   ivec2 s0, s1, s2; // screen, fixed point (within the guard band: below 2^23)
   bool wide;        // spans kNarrowExtent or more: edge functions in 64 bits
@@ -71,7 +70,8 @@ bool setupTriangle(uint view, uint f, out Triangle t) {
   t.area = 0.0;
   t.sign = 1.0;
   t.box = ivec4(0, 0, -1, -1);
-  // Three calls, not a loop over arrays: see Triangle.
+  // Three calls, not a loop with early returns over the struct's arrays: on lavapipe that loop
+  // was most of the setup's cost (an 8 x 8 window of a 62k-face mesh 14 -> 8 ms).
   vec3 p0, p1, p2;
   float rz0, rz1, rz2;
   ivec2 s0, s1, s2;
