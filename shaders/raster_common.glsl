@@ -33,7 +33,7 @@ struct Triangle {
   ivec4 box;        // inclusive pixel bounds, clipped to the image
   vec3 rz;          // 1 / z per vertex
   vec3 n;           // plane normal (unnormalized), camera frame
-  float n_p0;       // dot(n, p[0])
+  float n_p0;       // dot(n, the first corner)
   vec2 zrange;      // nearest and farthest vertex depth
 };
 
