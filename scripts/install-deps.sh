@@ -10,7 +10,7 @@ PACKAGES=(
   libeigen3-dev
   libopencv-dev libopencv-contrib-dev
   libassimp-dev assimp-testmodels
-  libpcl-dev liboctomap-dev
+  libpcl-dev liboctomap-dev libmeshoptimizer-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev
   python3-dev python3-pybind11 python3-numpy python3-pytest python3-opencv
