@@ -2,6 +2,7 @@
 // shapes, and the orientation of the image (no mirrored or flipped renderings).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -59,6 +60,25 @@ Agreement compare(const Rendering& a, const Rendering& b) {
     }
   g.mask_agree = static_cast<double>(same) / a.depth.total();
   return g;
+}
+
+/// Where the ray through pixel (x, y) first meets a sphere at `centre`: the depth, the unit
+/// normal there, and the cosine between the ray and that normal. Empty when it misses.
+struct SphereHit {
+  float z = 0.f, cos_view = 0.f;
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+};
+std::optional<SphereHit> raySphere(const Camera& cam, int x, int y, const Eigen::Vector3f& centre, float radius) {
+  const Eigen::Vector3f d((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);
+  // |s d - c| = radius, nearest root.
+  const float a = d.dot(d), b = -2.f * d.dot(centre), k = centre.dot(centre) - radius * radius;
+  const float disc = b * b - 4 * a * k;
+  if (disc <= 0.f) return std::nullopt;
+  SphereHit hit;
+  hit.z = (-b - std::sqrt(disc)) / (2 * a);
+  hit.normal = (hit.z * d - centre).normalized();
+  hit.cos_view = std::abs(hit.normal.dot(d.normalized()));
+  return hit;
 }
 
 TEST(Render, GpuMatchesReferenceOnTheCoffeeCupAndAColouredPly) {
@@ -175,20 +195,14 @@ TEST(Render, SphereDepthEqualsRayCastingWithinFacetting) {
   int checked = 0;
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
-      const Eigen::Vector3f d((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);
-      const Eigen::Vector3f& c = pose.t;
-      // |s d - c| = radius, nearest root; interior pixels only (away from grazing rays).
-      const float a = d.dot(d), b = -2.f * d.dot(c), k = c.dot(c) - radius * radius;
-      const float disc = b * b - 4 * a * k;
-      if (disc <= 0.f) continue;
-      const float s = (-b - std::sqrt(disc)) / (2 * a);
-      const Eigen::Vector3f p = s * d - c;
-      if (std::abs(p.normalized().dot(d.normalized())) < 0.5f) continue;
+      // Interior pixels only (away from grazing rays).
+      const auto hit = raySphere(cam, x, y, pose.t, radius);
+      if (!hit || hit->cos_view < 0.5f) continue;
       ASSERT_GT(r.depth.at<float>(y, x), 0.f) << x << "," << y;
-      EXPECT_NEAR(r.depth.at<float>(y, x), s, 1e-4f) << x << "," << y;
+      EXPECT_NEAR(r.depth.at<float>(y, x), hit->z, 1e-4f) << x << "," << y;
       // The interpolated vertex normals approximate the sphere's normal.
       const cv::Vec3f n = r.normals.at<cv::Vec3f>(y, x);
-      EXPECT_GT(n.dot(cv::Vec3f(p.normalized().x(), p.normalized().y(), p.normalized().z())), 0.999f);
+      EXPECT_GT(n.dot(cv::Vec3f(hit->normal.x(), hit->normal.y(), hit->normal.z())), 0.999f);
       ++checked;
     }
   EXPECT_GT(checked, 2000);
@@ -287,15 +301,9 @@ TEST(Render, SimplifiedSphereStaysWithinItsErrorOfRayCasting) {
   int checked = 0;
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
-      const Eigen::Vector3f d((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);
-      const Eigen::Vector3f& c = pose.t;
-      const float a = d.dot(d), b = -2.f * d.dot(c), k = c.dot(c) - radius * radius;
-      const float disc = b * b - 4 * a * k;
-      if (disc <= 0.f) continue;
-      const float s = (-b - std::sqrt(disc)) / (2 * a);
-      const Eigen::Vector3f p = s * d - c;
-      const float cos_view = std::abs(p.normalized().dot(d.normalized()));
-      if (cos_view < 0.5f) continue;
+      const auto hit = raySphere(cam, x, y, pose.t, radius);
+      if (!hit || hit->cos_view < 0.5f) continue;
+      const float s = hit->z, cos_view = hit->cos_view;
       // Facets of a sphere lie inside it: the depth is at least the sphere's, and at most twice
       // the error along the ray (1 / cos of the viewing angle) behind it. Twice: the error is
       // meshoptimizer's quadric estimate, which on a sphere undershoots (measured: 1.72 times).
