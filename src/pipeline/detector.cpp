@@ -31,6 +31,9 @@ namespace vkpose {
 namespace {
 using util::msSince;
 
+/// Where a pose puts a point of the object's frame (the bank's centre, mostly).
+Eigen::Vector3f placed(const Pose& pose, const Eigen::Vector3f& point) { return pose.R * point + pose.t; }
+
 /// Two candidates whose refined poses lie this close (share of the diameter, between the
 /// centres) and turn by less than this are one candidate twice (Detector::estimatePoses).
 constexpr float kTwinDistance = 0.05f;
@@ -63,7 +66,7 @@ bool samePlace(const Detection& a, const Detection& b, const std::vector<Templat
                float duplicate_fraction) {
   const TemplateBank& ba = banks.at(static_cast<std::size_t>(a.bank));
   const TemplateBank& bb = banks.at(static_cast<std::size_t>(b.bank));
-  const Eigen::Vector3f ca = a.pose.R * ba.centre + a.pose.t, cb = b.pose.R * bb.centre + b.pose.t;
+  const Eigen::Vector3f ca = placed(a.pose, ba.centre), cb = placed(b.pose, bb.centre);
   return (ca - cb).norm() < duplicate_fraction * std::min(ba.diameter, bb.diameter);
 }
 
@@ -96,7 +99,7 @@ void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vec
   cv::Rect2f box;
   bool first = true;
   for (const auto& p : model_points) {
-    const Eigen::Vector3f c = d.pose.R * p + d.pose.t;
+    const Eigen::Vector3f c = placed(d.pose, p);
     if (!(c.z() > 0.f)) continue;
     const Eigen::Vector2f uv = camera.project(c);
     const cv::Rect2f px(uv.x(), uv.y(), 1.f, 1.f);
@@ -104,7 +107,7 @@ void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vec
     first = false;
   }
   if (!first) d.bbox = box;
-  const Eigen::Vector3f c = d.pose.R * centre + d.pose.t;
+  const Eigen::Vector3f c = placed(d.pose, centre);
   if (c.z() > 0.f) {
     const Eigen::Vector2f uv = camera.project(c);
     d.x = uv.x();
@@ -198,7 +201,7 @@ Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate&
                   const Camera& camera) {
   // The training camera looked at the bank's centre, so the centre sits on the template's
   // optical axis; on the scene's ray it moves by the measured depth offset.
-  const float range = (t.pose.R * bank.centre + t.pose.t).norm() + s.depth_offset;
+  const float range = placed(t.pose, bank.centre).norm() + s.depth_offset;
   return poseAtRange(viewingRayRotation(h.x, h.y, camera) * t.pose.R, h.x, h.y, range, bank.centre, camera);
 }
 
@@ -486,7 +489,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
       for (const std::size_t k : kept) {
         const Pose& q = refined[k].pose;
         if (hypotheses[k].bank != hypotheses[i].bank ||
-            (p.R * banks_[b].centre + p.t - q.R * banks_[b].centre - q.t).norm() > kTwinDistance * banks_[b].diameter ||
+            (placed(p, banks_[b].centre) - placed(q, banks_[b].centre)).norm() > kTwinDistance * banks_[b].diameter ||
             Eigen::AngleAxisf(p.R.transpose() * q.R).angle() > kTwinAngleRad)
           continue;
         twin[i] = 1;
