@@ -353,13 +353,13 @@ TEST(Render, SimplifiedPaintedPlaneKeepsItsColourBorder) {
   const Pose pose{Eigen::Matrix3f::Identity(), Eigen::Vector3f(0.f, 0.f, 0.4f)};
   const Rendering full = renderReference(plane, cam, pose), r = renderReference(simple, cam, pose);
   ASSERT_GT(cv::countNonZero(full.mask()), 5000);
+  const float seam_x = static_cast<float>(cam.cx + cam.fx * pose.t.x() / pose.t.z());
   int compared = 0;
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
       if (!(full.depth.at<float>(y, x) > 0.f)) continue;
       EXPECT_GT(r.depth.at<float>(y, x), 0.f) << x << "," << y;  // no holes
       EXPECT_NEAR(r.depth.at<float>(y, x), full.depth.at<float>(y, x), 1e-5f) << x << "," << y;
-      const float seam_x = static_cast<float>(cam.cx + cam.fx * pose.t.x() / pose.t.z());
       if (std::abs(static_cast<float>(x) - seam_x) < 2.f) continue;
       const cv::Vec3b a = full.bgr.at<cv::Vec3b>(y, x), b = r.bgr.at<cv::Vec3b>(y, x);
       for (int c = 0; c < 3; ++c) EXPECT_LE(std::abs(a[c] - b[c]), 2) << x << "," << y;  // no purple
@@ -371,11 +371,11 @@ TEST(Render, SimplifiedPaintedPlaneKeepsItsColourBorder) {
 TEST(Render, SimplifiedCoffeeCupLooksTheSameWithAFifteenthOfItsFaces) {
   VKPOSE_REQUIRE_SHARED_DATA();
   const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl");
-  // The detector's setting (detector.cpp, kRenderSimplification): 0.2 % of the diameter.
-  const Mesh simple = simplifiedForRendering(cup, 0.002f * cup.diameter);
+  // The detector's setting: 0.2 % of the diameter.
+  const Mesh simple = simplifiedForRendering(cup, kDetectionRenderError * cup.diameter);
   EXPECT_LT(simple.faces.size() * 15, cup.faces.size());
   const Mesh box = test::boxMesh({0.1f, 0.1f, 0.1f});
-  EXPECT_EQ(simplifiedForRendering(box, 0.002f * box.diameter).faces.size(), box.faces.size());  // nothing to take
+  EXPECT_EQ(simplifiedForRendering(box, kDetectionRenderError * box.diameter).faces.size(), box.faces.size());  // nothing to take
   const Camera cam = smallCamera();
   MeshRenderer full(test::context(), cup), coarse(test::context(), simple);
   const std::vector<Pose> poses = {viewPose({0.3f, -0.5f, 0.8f}, 0.6f, 20.f, cup.bboxCentre()),

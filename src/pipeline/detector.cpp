@@ -39,11 +39,6 @@ Eigen::Vector3f placed(const Pose& pose, const Eigen::Vector3f& point) { return 
 constexpr float kTwinDistance = 0.05f;
 constexpr float kTwinAngleRad = 0.0873f;  // 5 degrees
 
-/// How far the detector's renderings may move the surface, share of the diameter
-/// (simplifiedForRendering, an estimate that may be 1.7 times short): 0.27 mm on the 13.7 cm
-/// cup, under half a pixel at 0.6 m even then.
-constexpr float kRenderSimplification = 0.002f;
-
 /// A verified pose's score: the collision rate, times the share not seen through, times the
 /// outline's support (Detection::score).
 float poseScore(float collision_rate, float see_through, float silhouette_support) {
@@ -360,7 +355,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     // rasterizer's cost is their setup. The IC-BIN cup: 61,766 -> 3,938 faces, stage 6
     // 175 -> 62 ms a frame, the same detections (docs/performance.md).
     for (const auto& b : banks_) {
-      const Mesh m = simplifiedForRendering(b.mesh, kRenderSimplification * b.diameter);
+      const Mesh m = simplifiedForRendering(b.mesh, kDetectionRenderError * b.diameter);
       renderers_.push_back(std::make_unique<MeshRenderer>(ctx_, m, workspace));
     }
   }

@@ -1,6 +1,5 @@
 #include "render/simplify.hpp"
 
-#include <cstdint>
 #include <vector>
 
 #include <meshoptimizer.h>
