@@ -158,6 +158,58 @@ TEST(UpAxis, RestingAutoTrainsEveryPoseOfASmallPartOnly) {
   EXPECT_THROW(trainsOtherRestingPoses("sideways", 0.04f), InputError);
 }
 
+// planTraining: what `vkpose train` and vkpose.train() decide before rendering. A brick 4 cm
+// long is a small part, so "auto" trains its other resting poses besides the up axis found;
+// "up" finds and reports them without training them; the full sphere has none; an up axis
+// given is kept.
+TEST(UpAxis, TrainingPlanTakesTheUpAxisFoundAndTrainsRestingPosesAsAsked) {
+  const Mesh brick = test::boxMesh({0.04f, 0.02f, 0.012f});
+  const auto plan = [&](bool auto_up, const std::string& resting, bool full_sphere, TrainingParams& params) {
+    params.views.viewpoints = 30;
+    params.views.radii = {0.3f, 0.4f, 0.1f};
+    params.views.inplane_deg = {0.f, 0.f, 10.f};
+    params.views.full_sphere = full_sphere;
+    return planTraining(brick, params, auto_up, resting, 80.f);
+  };
+  const UpAxisChoice found = findUpAxis(brick);
+  ASSERT_TRUE(found.found) << found.reason;
+
+  TrainingParams automatic;
+  const TrainingPlan a = plan(true, "auto", false, automatic);
+  EXPECT_EQ(upAxisName(automatic.views.up), upAxisName(found.up));
+  EXPECT_EQ(upAxisName(a.found.up), upAxisName(found.up));
+  ASSERT_FALSE(a.other_ups.empty());
+  EXPECT_TRUE(a.trains_other_ups);
+  EXPECT_EQ(names(automatic.views.other_ups), names(a.other_ups));
+  for (const Eigen::Vector3f& u : a.other_ups) EXPECT_LT(u.dot(automatic.views.up), 0.99f);
+  // Each hemisphere's views, the same as sampling them by hand.
+  EXPECT_EQ(a.views.size(), viewsAbove(sampleViews(automatic.views, brick.bboxCentre()), brick.bboxCentre(), 80.f).size());
+  std::set<std::string> ups;
+  for (const TrainingView& v : a.views) ups.insert(upAxisName(v.up));
+  EXPECT_EQ(ups.size(), 1u + a.other_ups.size());
+
+  TrainingParams standing;
+  const TrainingPlan s = plan(true, "up", false, standing);
+  EXPECT_EQ(names(s.other_ups), names(a.other_ups));  // found and reported, not trained
+  EXPECT_FALSE(s.trains_other_ups);
+  EXPECT_TRUE(standing.views.other_ups.empty());
+  EXPECT_LT(s.views.size(), a.views.size());
+
+  TrainingParams given;
+  given.views.up = parseUpAxis("-x");
+  const TrainingPlan g = plan(false, "up", false, given);
+  EXPECT_EQ(upAxisName(given.views.up), "-x");  // kept as the user gave it
+  EXPECT_EQ(upAxisName(g.found.up), upAxisName(found.up));
+
+  TrainingParams sphere;
+  const TrainingPlan f = plan(true, "all", true, sphere);
+  EXPECT_TRUE(f.other_ups.empty());
+  EXPECT_TRUE(sphere.views.other_ups.empty());
+
+  TrainingParams bad;
+  EXPECT_THROW(plan(true, "sideways", false, bad), InputError);
+}
+
 TEST(UpAxis, EachRestingPoseHasAHemisphereOfViews) {
   ViewSamplingParams params;
   params.viewpoints = 40;

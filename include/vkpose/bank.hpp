@@ -231,6 +231,25 @@ void validateTrainingParams(const TrainingParams& params);
 /// vkpose.train() raises them as Python warnings.
 std::vector<std::string> trainingWarnings(const Mesh& mesh, const TrainingParams& params);
 
+/// What training decides about an object before it renders anything: the up axis, the other
+/// poses it rests in, and the views. `vkpose train` and Python's vkpose.train() both take it
+/// from planTraining, so that a bank trained either way with the same options is the same.
+struct TrainingPlan {
+  UpAxisChoice found;  ///< findUpAxis's verdict, also where an up axis was given
+  /// The other poses it rests in (otherRestingUps), whether trained or not; none with the
+  /// full sphere, which sees every side.
+  std::vector<Eigen::Vector3f> other_ups;
+  bool trains_other_ups = false;   ///< their hemispheres are in `views`
+  std::vector<TrainingView> views;  ///< sampleViews then viewsAbove
+};
+
+/// Fills in `params.views`: `up` from findUpAxis where `auto_up` (else it is kept as given), and
+/// `other_ups` where trainsOtherRestingPoses(`resting`) and not the full sphere; then samples
+/// the views within `max_view_angle_deg` of each hemisphere's top. Throws InputError for a
+/// `resting` other than auto, all, up, or when no view is left.
+TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up, const std::string& resting,
+                          float max_view_angle_deg);
+
 /// Depth and normals of a rendered template, sampled every `stride` pixels over the object's
 /// box: cell (i, j) is template pixel (x0 + j * stride, y0 + i * stride) (level 0, relative
 /// to the template's top-left corner; x0, y0 <= 0 when the object reaches past the features).

@@ -242,15 +242,8 @@ void bindCore(py::module_& m) {
           if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
         const auto report = progressOf(progress, "training");
         py::gil_scoped_release nogil;
-        const UpAxisChoice choice = findUpAxis(mesh);
-        if (up == "auto") params.views.up = choice.up;
-        if (trainsOtherRestingPoses(resting, mesh.diameter) && !params.views.full_sphere)
-          params.views.other_ups = otherRestingUps(
-              choice, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
         const std::vector<TrainingView> training_views =
-            viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle);
-        if (training_views.empty())
-          throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", max_view_angle));
+            planTraining(mesh, params, up == "auto", resting, max_view_angle).views;
         std::lock_guard<std::mutex> lock(dev->mutex);
         if (!cache.empty())
           return std::make_shared<TemplateBank>(

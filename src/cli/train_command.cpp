@@ -102,12 +102,11 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       fmt::print("diameter: {:.4f} m\n", mesh.diameter);
     }
     for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
-    const UpAxisChoice up = findUpAxis(mesh);
+    const TrainingPlan plan = planTraining(mesh, params, opt->up == "auto", opt->resting, opt->max_view_angle);
     if (opt->up == "auto") {
-      params.views.up = up.up;
-      fmt::print("up axis: {} (auto: {})\n", upAxisName(up.up), up.reason);
+      fmt::print("up axis: {} (auto: {})\n", upAxisName(params.views.up), plan.found.reason);
       if (global.verbose)
-        for (const RestingCandidate& c : up.candidates)
+        for (const RestingCandidate& c : plan.found.candidates)
           fmt::print("  {} up: base {:.0f}% of the footprint, {:.0f} degrees off the axis, centre of mass {:.1f} mm "
                      "inside it{}\n",
                      upAxisName(c.up), 100.f * c.support, c.tilt_deg, 1e3f * c.margin_m, c.stands() ? ", stands" : "");
@@ -115,27 +114,20 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
     }
     if (!params.views.full_sphere) {
-      const std::vector<Eigen::Vector3f> others = otherRestingUps(
-          up, params.views.up, findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
-      const bool all = trainsOtherRestingPoses(opt->resting, mesh.diameter);
-      if (all) params.views.other_ups = others;
-      fmt::print("other resting poses: {} ({})\n", restingUpsText(others),
-                 others.empty() ? "it stands on no other side, or near-symmetries cover them"
-                 : all && opt->resting == "auto"
+      fmt::print("other resting poses: {} ({})\n", restingUpsText(plan.other_ups),
+                 plan.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
+                 : plan.trains_other_ups && opt->resting == "auto"
                      ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
                                    "in a bin; --resting up trains it standing only",
                                    1e3f * mesh.diameter)
-                 : all ? "a hemisphere of views about each as well"
+                 : plan.trains_other_ups ? "a hemisphere of views about each as well"
                        : "not trained: pass --resting all to find it lying down too");
     }
     GpuContext ctx(global.gpu());
     ProgressBar bar("training", global.quiet);
     TrainingTimings timings;
-    const std::vector<TrainingView> views =
-        viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), opt->max_view_angle);
-    if (views.empty()) throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", opt->max_view_angle));
     const TemplateBank bank = trainTemplatesFromViews(
-        ctx, mesh, params, views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);
+        ctx, mesh, params, plan.views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);
     bar.finish();
     saveBank(bank, opt->out);
     const auto bytes = std::filesystem::file_size(opt->out);

@@ -1,4 +1,5 @@
-// The object's up axis, found from its mesh: which end it stands on (findUpAxis, bank.hpp).
+// The object's up axis, found from its mesh: which end it stands on (findUpAxis, bank.hpp), the
+// other poses it rests in, and what training makes of them (planTraining).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -187,6 +188,25 @@ bool trainsOtherRestingPoses(const std::string& resting, float diameter_m) {
   if (resting == "up") return false;
   if (resting == "auto") return isSmallPart(diameter_m);
   throw InputError(fmt::format("resting: '{}' is none of auto, all, up", resting));
+}
+
+TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up, const std::string& resting,
+                          float max_view_angle_deg) {
+  TrainingPlan plan;
+  const bool trains_others = trainsOtherRestingPoses(resting, mesh.diameter);  // throws first on a bad name
+  plan.found = findUpAxis(mesh);
+  if (auto_up) params.views.up = plan.found.up;
+  params.views.other_ups.clear();
+  if (!params.views.full_sphere) {
+    plan.other_ups = otherRestingUps(plan.found, params.views.up,
+                                     findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
+    plan.trains_other_ups = trains_others && !plan.other_ups.empty();
+    if (trains_others) params.views.other_ups = plan.other_ups;
+  }
+  plan.views = viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle_deg);
+  if (plan.views.empty())
+    throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", max_view_angle_deg));
+  return plan;
 }
 
 }  // namespace vkpose
