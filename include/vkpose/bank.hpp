@@ -236,10 +236,9 @@ std::vector<std::string> trainingWarnings(const Mesh& mesh, const TrainingParams
 /// from planTraining, so that a bank trained either way with the same options is the same.
 struct TrainingPlan {
   UpAxisChoice found;  ///< findUpAxis's verdict, also where an up axis was given
-  /// The other poses it rests in (otherRestingUps), whether trained or not; none with the
-  /// full sphere, which sees every side.
+  /// The other poses it rests in (otherRestingUps), whether trained or not (those trained are
+  /// params.views.other_ups); none with the full sphere, which sees every side.
   std::vector<Eigen::Vector3f> other_ups;
-  bool trains_other_ups = false;   ///< their hemispheres are in `views`
   std::vector<TrainingView> views;  ///< sampleViews then viewsAbove
 };
 

@@ -114,13 +114,14 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
     }
     if (!params.views.full_sphere) {
+      const bool trained = !params.views.other_ups.empty();
       fmt::print("other resting poses: {} ({})\n", restingUpsText(plan.other_ups),
                  plan.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
-                 : plan.trains_other_ups && opt->resting == "auto"
+                 : trained && opt->resting == "auto"
                      ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
                                    "in a bin; --resting up trains it standing only",
                                    1e3f * mesh.diameter)
-                 : plan.trains_other_ups ? "a hemisphere of views about each as well"
+                 : trained ? "a hemisphere of views about each as well"
                        : "not trained: pass --resting all to find it lying down too");
     }
     GpuContext ctx(global.gpu());

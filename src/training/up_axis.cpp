@@ -200,7 +200,6 @@ TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up
   if (!params.views.full_sphere) {
     plan.other_ups = otherRestingUps(plan.found, params.views.up,
                                      findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
-    plan.trains_other_ups = trains_others && !plan.other_ups.empty();
     if (trains_others) params.views.other_ups = plan.other_ups;
   }
   plan.views = viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle_deg);
