@@ -267,6 +267,18 @@ TEST(InitialTranslation, AnOccluderDoesNotPullTheModelForward) {
   EXPECT_LT(std::abs(p.pose.t.z() - c.truth.t.z()), 0.004f);
 }
 
+// A start more than the depth band short (here 6 cm, the band 3 cm for this 9 cm box) pairs no
+// scene pixel: everything under the mask looks like background. The second try moves it by
+// the median depth difference under the mask, and the shift then lands on the box.
+TEST(InitialTranslation, AStartCentimetresShortGetsASecondTry) {
+  const TranslationCase c = translationCase({0.f, 0.f, -0.06f});
+  ASSERT_LT(InitialPoseParams{}.depth_band_fraction * c.box.diameter, 0.04f);
+  const InitialPose p = initialTranslation(c.rendering, c.rendered, c.scene_depth, c.camera, c.box.diameter);
+  ASSERT_TRUE(p.ok) << p.why;
+  EXPECT_LT(std::abs(p.pose.t.z() - c.truth.t.z()), 0.006f);
+  EXPECT_GT(p.object_pixels, p.mask_pixels / 2);
+}
+
 TEST(InitialTranslation, ABlackHoleIsRejectedWithAReason) {
   TranslationCase c = translationCase({0.f, 0.f, 0.f});
   c.scene_depth.setTo(0.f);

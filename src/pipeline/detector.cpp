@@ -39,6 +39,13 @@ Eigen::Vector3f placed(const Pose& pose, const Eigen::Vector3f& point) { return 
 constexpr float kTwinDistance = 0.05f;
 constexpr float kTwinAngleRad = 0.0873f;  // 5 degrees
 
+/// The collision rate a candidate needs when stage 6's first start paired no scene pixel and
+/// the second try moved it along the camera's axis (InitialPose::second_try_m). That move
+/// searches the whole ray for a surface, so it finds one on whatever lies there: on the LM-O
+/// frame a glue bottle placed on a box's face at the image's edge (collision 0.46); the cups
+/// the move found on the lying stress set (off-axis starts 6-9 cm short) reach 0.87-0.95.
+constexpr float kSecondTryMinCollision = 0.6f;
+
 /// A verified pose's score: the collision rate, times the share not seen through, times the
 /// outline's support (Detection::score).
 float poseScore(float collision_rate, float see_through, float silhouette_support) {
@@ -397,6 +404,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     refine_params[i] = scaled.refine;
     verify_params[i] = scaled.verify;
     if (isSmallPart(diameter)) verify_params[i].min_colour_agreement = params_.verify.small_part_min_colour_agreement;
+    if (initial[i].second_try_m != 0.f)
+      verify_params[i].threshold = std::max(verify_params[i].threshold, kSecondTryMinCollision);
   }
 
   // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).

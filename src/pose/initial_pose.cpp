@@ -212,7 +212,6 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
   out.model_points = visibleModelPoints(rendering, rendered, camera, window);
   for (int v = window.y; v < window.y + window.height; ++v) {
     const float* zr = rendering.depth.ptr<float>(v - window.y);
-    const float* zs = scene_depth_m.ptr<float>(v);
     for (int u = window.x; u < window.x + window.width; ++u) {
       const float z = zr[u - window.x];
       if (!(z > 0.f)) continue;
@@ -220,18 +219,51 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
       box |= cv::Rect(u, v, 1, 1);
       z_min = std::min(z_min, z);
       z_max = std::max(z_max, z);
-      const Eigen::Vector3f pm = backProject(u, v, z);
-      if (!(zs[u] > 0.f) || zs[u] < z - band) continue;  // no depth, or an occluder
-      model_sum += pm.cast<double>();
-      ++model_count;
-      if (zs[u] > z + band) continue;  // background seen past the object's edge
-      scene_sum += backProject(u, v, zs[u]).cast<double>();
-      ++out.object_pixels;
     }
   }
   if (out.mask_pixels == 0) {
     out.why = "the model renders outside the image";
     return out;
+  }
+  // The pixels that pair the rendering with the scene when the rendering is moved `dz` along
+  // the camera's axis: the moved depths choose the pairs, the centroids stay the unmoved
+  // model's, so the shift below carries the move. `differences` collects scene minus rendered
+  // depth under the mask.
+  auto pair = [&](float dz, std::vector<float>* differences) {
+    scene_sum.setZero();
+    model_sum.setZero();
+    model_count = 0;
+    out.object_pixels = 0;
+    for (int v = window.y; v < window.y + window.height; ++v) {
+      const float* zr = rendering.depth.ptr<float>(v - window.y);
+      const float* zs = scene_depth_m.ptr<float>(v);
+      for (int u = window.x; u < window.x + window.width; ++u) {
+        const float z = zr[u - window.x];
+        if (!(z > 0.f)) continue;
+        if (differences && zs[u] > 0.f) differences->push_back(zs[u] - z);
+        const float zm = z + dz;
+        if (!(zs[u] > 0.f) || zs[u] < zm - band) continue;  // no depth, or an occluder
+        model_sum += backProject(u, v, z).cast<double>();
+        ++model_count;
+        if (zs[u] > zm + band) continue;  // background seen past the object's edge
+        scene_sum += backProject(u, v, zs[u]).cast<double>();
+        ++out.object_pixels;
+      }
+    }
+  };
+  std::vector<float> differences;
+  pair(0.f, &differences);
+  // A start more than the band short or long (the template's range is a z-range, and off the
+  // optical axis the range along the ray is longer; a lying object's template can sit a few
+  // centimetres off its centre) pairs no pixel. It gets a second try, moved by the median
+  // depth difference under its mask.
+  if (out.object_pixels < params.min_scene_points && differences.size() >= params.min_scene_points) {
+    const auto mid = differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2);
+    std::nth_element(differences.begin(), mid, differences.end());
+    if (std::abs(*mid) > band) {
+      pair(*mid, nullptr);
+      out.second_try_m = *mid;
+    }
   }
   if (out.object_pixels < params.min_scene_points) {
     out.why = fmt::format("{} of the {} pixels under the model have scene depth near it (at least {} needed)",

@@ -108,6 +108,9 @@ struct InitialPose {
   PointCloud scene_points;
   std::size_t mask_pixels = 0;   ///< rendered object pixels
   std::size_t object_pixels = 0; ///< scene pixels under the mask that fell in the depth band
+  /// How far the second try moved the start along the camera's axis, metres (0: the first
+  /// start paired); the detector asks more of such a candidate (kSecondTryMinCollision).
+  float second_try_m = 0.f;
   bool ok = false;               ///< false: too few object pixels; `why` says so
   std::string why;
 };
