@@ -293,6 +293,9 @@ TEST(InitialTranslation, ABlackHoleIsRejectedWithAReason) {
   InitialPoseParams bad;
   bad.rotation_cluster_deg = 0.f;
   EXPECT_THROW(validateInitialPoseParams(bad), InputError);
+  bad = {};
+  bad.resting_poses_starts = 0;
+  EXPECT_THROW(validateInitialPoseParams(bad), InputError);
 }
 
 }  // namespace

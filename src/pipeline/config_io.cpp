@@ -56,6 +56,10 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"initial_pose", "small_part_starts",
        "parts under 10 cm: starts a hypothesis from this many of its largest rotation groups",
        &p.initial_pose.small_part_starts},
+      {"initial_pose", "resting_poses_starts",
+       "banks trained in several resting poses (train --resting all): starts a hypothesis from this many of its largest "
+       "rotation groups",
+       &p.initial_pose.resting_poses_starts},
       {"initial_pose", "range_along_ray",
        "convert the depth offset (a z-range) into the range along the viewing ray: objects off the optical axis",
        &p.initial_pose.range_along_ray},

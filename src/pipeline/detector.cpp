@@ -340,7 +340,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   std::vector<Pose> rendered;
   for (const Hypothesis& h : clusters) {
     const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
-    const int starts = isSmallPart(bank.diameter) ? params_.initial_pose.small_part_starts : 1;
+    const int starts = std::max(isSmallPart(bank.diameter) ? params_.initial_pose.small_part_starts : 1,
+                                bank.params.views.other_ups.empty() ? 1 : params_.initial_pose.resting_poses_starts);
     const InitialRotation rot = initialRotation(h, bank, camera, params_.initial_pose, params_.score, starts);
     const auto start = [&](const Eigen::Matrix3f& R, int votes) {
       hypotheses.push_back(h);

@@ -31,6 +31,9 @@ void validateScoreParams(const ScoreParams& p) {
 void validateInitialPoseParams(const InitialPoseParams& p) {
   if (p.small_part_starts < 1 || p.small_part_starts > 16)
     throw InputError(fmt::format("the small parts' starts must be 1 to 16, not {}", p.small_part_starts));
+  if (p.resting_poses_starts < 1 || p.resting_poses_starts > 16)
+    throw InputError(fmt::format("the starts of banks of several resting poses must be 1 to 16, not {}",
+                                 p.resting_poses_starts));
   if (!(p.rotation_cluster_deg > 0.f && p.rotation_cluster_deg <= 180.f))
     throw InputError(fmt::format("the rotation cluster angle must be in (0, 180] degrees, not {}",
                                  p.rotation_cluster_deg));
