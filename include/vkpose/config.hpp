@@ -107,11 +107,11 @@ struct InitialPoseParams {
   /// Where stage 6 puts a hypothesis: the template's range plus the cluster score's depth
   /// offset is a z-range, and off the optical axis the range along the ray is longer by
   /// 1 / cos(theta) (rangeOnRay): true converts it. Off (today's default), an object 20
-  /// degrees off the axis starts 6 % short (5 cm at 0.85 m) and is rejected before ICP
-  /// ("no scene depth near it"), so nothing is found in the image's outer part. On, the lying
-  /// stress set's average F1 rises from 0.837 to 0.919 (docs/pipeline.md, stage 6), but on
-  /// the real LM-O frame four look-alikes at its edges (unannotated objects taken for the ape
-  /// and the glue) then pass verification: it stays off until verification rejects them.
+  /// degrees off the axis starts 6 % short (5 cm at 0.85 m); where that is more than the depth
+  /// band, stage 6's second try moves it along the axis onto the scene (and verification then
+  /// asks a collision rate above 0.6 of it). On, every start moves, and on the real LM-O frame
+  /// a look-alike at its edge (an unannotated object taken for the glue) passes verification
+  /// and the true glue ends ICP 9 mm off: it stays off (docs/pipeline.md, stage 6).
   bool range_along_ray = false;
   /// A scene pixel under the rendered mask belongs to the object when its depth lies within
   /// this fraction of the object's diameter of the rendered depth there. Nearer is an
