@@ -251,18 +251,22 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
       }
     }
   };
-  std::vector<float> differences;
-  pair(0.f, &differences);
+  pair(0.f, nullptr);
   // A start more than the band short or long (the template's range is a z-range, and off the
   // optical axis the range along the ray is longer; a lying object's template can sit a few
   // centimetres off its centre) pairs no pixel. It gets a second try, moved by the median
-  // depth difference under its mask.
-  if (out.object_pixels < params.min_scene_points && differences.size() >= params.min_scene_points) {
-    const auto mid = differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2);
-    std::nth_element(differences.begin(), mid, differences.end());
-    if (std::abs(*mid) > band) {
-      pair(*mid, nullptr);
-      out.second_try_m = *mid;
+  // depth difference under its mask: gathered by pairing once more, only here, since nearly
+  // every start pairs at once.
+  if (out.object_pixels < params.min_scene_points) {
+    std::vector<float> differences;
+    pair(0.f, &differences);
+    if (differences.size() >= params.min_scene_points) {
+      const auto mid = differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2);
+      std::nth_element(differences.begin(), mid, differences.end());
+      if (std::abs(*mid) > band) {
+        pair(*mid, nullptr);
+        out.second_try_m = *mid;
+      }
     }
   }
   if (out.object_pixels < params.min_scene_points) {
