@@ -12,7 +12,9 @@ layout(local_size_x = 64) in;
 layout(binding = 0) uniform utextureBuffer spread;  // packed (common.glsl); a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Memory { uvec2 memory[]; };
 layout(push_constant) uniform Push {
-  int width; int height; int T; int pad; int stride; int rows; int modality;
+  int width; int height; int T; int pad; int stride; int rows;
+  int outside;  // response of cells outside the image (MatchParams::outside_response), every bin
+  int modality;
 } pc;
 void main() {
   int i = LINEAR_INVOCATION;
@@ -44,8 +46,9 @@ void main() {
         uint rotated = i == 0 ? CODES_OF_BIN_0 : (CODES_OF_BIN_0 << (4 * i)) | (CODES_OF_BIN_0 >> (32 - 4 * i));
         codes |= ((s >> uint(i)) & 1u) != 0u ? rotated : 0u;
       }
-      v[j] = (codes & 0x11111111u) + ((codes >> 1u) & 0x11111111u) + ((codes >> 2u) & 0x11111111u) +
-             ((codes >> 3u) & 0x11111111u);
+      v[j] = x >= 0 && x < pc.width ? (codes & 0x11111111u) + ((codes >> 1u) & 0x11111111u) +
+                                          ((codes >> 2u) & 0x11111111u) + ((codes >> 3u) & 0x11111111u)
+                                    : uint(pc.outside) * 0x11111111u;
     }
     // v[j] holds cell j's bins; the memory wants, per bin, its 8 cells: transpose the 8 x 8
     // nibbles in three rounds of swapping blocks (4 x 4, 2 x 2, then single nibbles).

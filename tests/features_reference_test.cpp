@@ -122,9 +122,11 @@ TEST(FeaturesReference, DepthMedianIsOpenCvsMedianBlur) {
 }
 
 // The coarse range may only drop positions that cannot pass: at every position of the
-// centre-in-image range, a template whose features inside the image could still score
-// above the threshold (4 each) must lie in the trimmed range, and the range must be smaller
-// than the whole image for a template near the size of the frame.
+// centre-in-image range, a template whose features could still score above the threshold
+// (4 each inside the image, the outside response each outside) must lie in the trimmed range,
+// and the range must be smaller than the whole image for a template near the size of the
+// frame: under OpenCV's rule (0 outside) much smaller, with vkpose's default wider but still
+// trimmed.
 TEST(CoarseRange, KeepsEveryPositionThatCanPassTheThreshold) {
   const LinearMemoryLayout layout = makeLinearMemoryLayout(160, 120, 8, 20, 0);
   cv::RNG rng(7);
@@ -135,24 +137,25 @@ TEST(CoarseRange, KeepsEveryPositionThatCanPassTheThreshold) {
     const int n = rng.uniform(1, 64);
     for (int i = 0; i < n; ++i)
       level.features.push_back({rng.uniform(0, level.width), rng.uniform(0, level.height), 0, Modality::ColourGradient});
-    for (const float percent : {50.f, 80.f, 95.f}) {
-      const int threshold = match::rawThreshold(n, percent);
-      const auto range = match::coarseRange(level, layout, threshold);
-      const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
-      for (int r = -(hf / 2); r < layout.cells_y - hf / 2; ++r)
-        for (int c = -(wf / 2); c < layout.cells_x - wf / 2; ++c) {
-          int inside = 0;
-          for (const auto& f : level.features) {
-            const int x = c + f.x / layout.T, y = r + f.y / layout.T;
-            inside += x >= 0 && x < layout.cells_x && y >= 0 && y < layout.cells_y;
+    for (const float percent : {50.f, 80.f, 95.f})
+      for (const int outside : {0, 3, 4}) {
+        const int threshold = match::rawThreshold(n, percent);
+        const auto range = match::coarseRange(level, layout, threshold, outside);
+        const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
+        for (int r = -(hf / 2); r < layout.cells_y - hf / 2; ++r)
+          for (int c = -(wf / 2); c < layout.cells_x - wf / 2; ++c) {
+            int inside = 0;
+            for (const auto& f : level.features) {
+              const int x = c + f.x / layout.T, y = r + f.y / layout.T;
+              inside += x >= 0 && x < layout.cells_x && y >= 0 && y < layout.cells_y;
+            }
+            const bool kept = c >= range.c_lo && c < range.c_lo + range.columns && r >= range.r_lo &&
+                              r < range.r_lo + range.rows;
+            if (4 * inside + outside * (n - inside) > threshold) {
+              EXPECT_TRUE(kept) << "trial " << trial << " at " << c << "," << r << ", outside response " << outside;
+            }
           }
-          const bool kept = c >= range.c_lo && c < range.c_lo + range.columns && r >= range.r_lo &&
-                            r < range.r_lo + range.rows;
-          if (4 * inside > threshold) {
-            EXPECT_TRUE(kept) << "trial " << trial << " at " << c << "," << r;
-          }
-        }
-    }
+      }
   }
   TemplateLevel wide;
   wide.width = 150;
@@ -160,10 +163,14 @@ TEST(CoarseRange, KeepsEveryPositionThatCanPassTheThreshold) {
   for (int y = 0; y < 110; y += 10)
     for (int x = 0; x < 150; x += 10) wide.features.push_back({x, y, 0, Modality::ColourGradient});
   const int n = static_cast<int>(wide.features.size());
-  const auto range = match::coarseRange(wide, layout, match::rawThreshold(n, 80.f));
+  const auto range = match::coarseRange(wide, layout, match::rawThreshold(n, 80.f), 0);
   EXPECT_LT(range.columns, layout.cells_x / 2);
   EXPECT_LT(range.rows, layout.cells_y / 2);
   EXPECT_GT(range.columns * range.rows, 0);
+  const auto credited = match::coarseRange(wide, layout, match::rawThreshold(n, 80.f), MatchParams{}.outside_response);
+  EXPECT_GT(credited.columns, range.columns);
+  EXPECT_LT(credited.columns, layout.cells_x);
+  EXPECT_LT(credited.rows, layout.cells_y);
 }
 
 }  // namespace

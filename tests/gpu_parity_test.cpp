@@ -1,5 +1,6 @@
 // GPU kernels == CPU reference, bit for bit, for every integer stage: label images of both
 // modalities at every level, the linear memories, and the matches.
+#include <algorithm>
 #include <cstdlib>
 
 #include "gpu/batch.hpp"
@@ -27,7 +28,8 @@ void expectFeatureParity(const LinemodFrame& frame, const FeatureParams& params,
   const auto layouts = match::makeLayouts(templates, params, frame.bgr.cols, frame.bgr.rows);
   gpu::FrameFeatures features(test::context(), params);
   gpu::Batch batch(test::context());
-  features.record(batch, frame, layouts);
+  const int outside = MatchParams{}.outside_response;
+  features.record(batch, frame, layouts, outside);
   std::vector<QuantizedLevel> gpu_levels;
   features.downloadLabels(batch, gpu_levels);
   std::vector<std::vector<uint8_t>> gpu_memory(layouts.size());
@@ -49,7 +51,7 @@ void expectFeatureParity(const LinemodFrame& frame, const FeatureParams& params,
       EXPECT_EQ(countDifferent(gpu_levels[l].labels[m], reference[l].labels[m]), 0)
           << name << ": level " << l << " modality " << m << " labels differ";
     }
-    std::vector<uint8_t> cpu_memory(layouts[l].total_bytes(), 0);
+    std::vector<uint8_t> cpu_memory(layouts[l].total_bytes(), static_cast<uint8_t>(outside));
     for (int m = 0; m < kModalityCount; ++m)
       if (!reference[l].labels[m].empty())
         linearizeResponseMaps(computeResponseMaps(spreadLabels(reference[l].labels[m], layouts[l].T)), m, layouts[l],
@@ -172,6 +174,60 @@ TEST(GpuParity, MatchesWithOneModalityAndOneLevel) {
   expectMatchParity(test::lmoFrame(), one_level, 30, 85.0f);
 }
 
+// A template cut by the left border: the features outside the image count the outside
+// response (MatchParams::outside_response). Each template is cut where a fifth of its
+// finest-level features fall outside: at 0 (OpenCV's rule) its own view can no longer pass
+// (4/5 of the features inside reach 3.2 of the 3.6 a feature that 80 % asks), at the default
+// 3 it passes again where it lies. GPU and CPU reference agree on the cut frame at 0, 3, 4.
+TEST(GpuParity, AViewCutByTheBorderCountsItsFeaturesOutsideAtTheOutsideResponse) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const auto frame = test::lmoFrame();
+  const FeatureParams params;
+  const auto templates = test::templatesFrom(frame, params, 30);
+  ASSERT_GT(templates.size(), 10u);
+  MatchParams mp;
+  ASSERT_EQ(mp.outside_response, 3);
+  const auto whole = matchTemplatesReference(quantizeFramePyramid(frame, params), templates, params, mp);
+  int tried = 0, found_at_default = 0;
+  for (std::size_t t = 0; t < templates.size() && tried < 3; ++t) {
+    // Its own view: the template's best match on the whole frame, near 100 %.
+    const auto own = std::find_if(whole.begin(), whole.end(), [&](const Match& m) {
+      return m.template_id == static_cast<int>(t) && m.similarity > 97.f;
+    });
+    if (own == whole.end()) continue;
+    std::vector<int> xs;
+    for (const auto& f : templates[t].levels[0].features) xs.push_back(f.x);
+    std::sort(xs.begin(), xs.end());
+    const int cut = xs[xs.size() / 5] + 1;  // features left of `cut` fall outside
+    const int x0 = own->x + cut;
+    if (cut <= 0 || x0 <= 0 || x0 >= frame.bgr.cols / 2) continue;
+    ++tried;
+    const cv::Rect keep(x0, 0, frame.bgr.cols - x0, frame.bgr.rows);
+    const LinemodFrame cropped{frame.bgr(keep).clone(), frame.depth_mm(keep).clone()};
+    const std::vector<LinemodTemplate> one{templates[t]};
+    const auto pyramid = quantizeFramePyramid(cropped, params);
+    for (const int outside : {0, 3, 4}) {
+      mp.outside_response = outside;
+      const auto reference = matchTemplatesReference(pyramid, one, params, mp);
+      LinemodMatcher matcher(test::context(), params, mp);
+      matcher.setTemplates(one);
+      EXPECT_EQ(matcher.match(cropped), reference) << "template " << t << ", outside response " << outside;
+      const bool there = std::any_of(reference.begin(), reference.end(), [&](const Match& m) {
+        return std::abs(m.x - (own->x - x0)) <= 5 && std::abs(m.y - own->y) <= 5;
+      });
+      if (outside == 0) {
+        EXPECT_FALSE(there) << "template " << t << " cut at " << cut << " px passed at 0";
+      } else if (outside == 3) {
+        found_at_default += there;
+      } else {
+        EXPECT_TRUE(there) << "template " << t << " cut at " << cut << " px did not pass at 4";
+      }
+    }
+  }
+  ASSERT_GT(tried, 0) << "no template had its own view far enough from the left border";
+  EXPECT_EQ(found_at_default, tried);
+}
+
 TEST(GpuParity, TemplatesWithMoreThan63FeaturesUse16BitSums) {
   VKPOSE_REQUIRE_SHARED_DATA();
   const auto frame = test::lmoFrame();
@@ -251,7 +307,8 @@ void expectPrunedParity(const LinemodFrame& frame, const std::vector<float>& dis
   for (std::size_t t = 0; t < templates.size(); ++t) {
     const auto& level = templates[t].levels.back();
     const auto range = match::coarseRange(
-        level, layouts.back(), match::rawThreshold(static_cast<int>(level.features.size()), mp.threshold));
+        level, layouts.back(), match::rawThreshold(static_cast<int>(level.features.size()), mp.threshold),
+        mp.outside_response);
     for (int r = range.r_lo; r < range.r_lo + range.rows; ++r)
       for (int c = range.c_lo; c < range.c_lo + range.columns; ++c) {
         ++pairs;

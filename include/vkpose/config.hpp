@@ -28,6 +28,12 @@ struct MatchParams {
   /// its training distance (docs/pipeline.md, stage 2): the same matches that pass that test,
   /// for less work.
   bool depth_pruning = true;
+  /// Response (0..4 of a feature's 4) that a template feature falling outside the image
+  /// counts. OpenCV's 0 costs an object cut by the border the share of its features that
+  /// lie outside, so its right views fall under the threshold while look-alike views of the
+  /// part inside win. At 3 a position near the border passes only where its features inside
+  /// the image match better than the threshold asks (3 of 4 is under the 3.6 that 80 % asks).
+  int outside_response = 3;
 };
 
 struct ClusterParams {

@@ -88,8 +88,9 @@ struct LinearMemoryLayout {
 /// `max_template_cells` cells in x or y; `extra_cells` more margin for local refinement.
 LinearMemoryLayout makeLinearMemoryLayout(int width, int height, int T, int max_template_cells, int extra_cells);
 
-/// Writes the 8 response maps of `modality` into `memory` (layout.total_bytes(), zeroed by
-/// the caller) in the linearized order of `layout`.
+/// Writes the 8 response maps of `modality` into `memory` (layout.total_bytes(), filled by
+/// the caller with the response of cells outside the image, MatchParams::outside_response)
+/// in the linearized order of `layout`.
 void linearizeResponseMaps(const std::array<cv::Mat, 8>& response_maps, int modality,
                            const LinearMemoryLayout& layout, std::vector<uint8_t>& memory);
 

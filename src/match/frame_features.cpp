@@ -104,10 +104,13 @@ std::vector<int> cumulativeCounts(const std::vector<int>& cells) {
 }
 }  // namespace
 
-CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold) {
+CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold,
+                        int outside_response) {
   const int wf = templateCells(level.width, layout.T), hf = templateCells(level.height, layout.T);
   if (level.features.empty()) return {-(wf / 2), -(hf / 2), 0, 0};
-  const int need = std::max(raw_threshold, 0) / 4 + 1;
+  // 4 inside + o (n - inside) > threshold  <=>  (4 - o) inside > threshold - o n.
+  const int excess = raw_threshold - outside_response * static_cast<int>(level.features.size());
+  const int need = excess < 0 || outside_response >= 4 ? 0 : excess / (4 - outside_response) + 1;
   std::vector<int> xs, ys;
   xs.reserve(level.features.size());
   ys.reserve(level.features.size());

@@ -43,7 +43,7 @@ struct FrameFeatures::Kernels {
         downsample(c, ShaderId::downsample_labels, 2, 12, {}, kWords),
         spread_rows(c, ShaderId::spread_rows, 2, 12, {}, kWords),
         spread(c, ShaderId::spread, 2, 12, {}, kWords),
-        linearize(c, ShaderId::response_linearize, 2, 28, {}, kWords) {}
+        linearize(c, ShaderId::response_linearize, 2, 32, {}, kWords) {}
   Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
@@ -52,7 +52,10 @@ FrameFeatures::FrameFeatures(const GpuContext& ctx, const FeatureParams& params)
 
 FrameFeatures::~FrameFeatures() = default;
 
-void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts) {
+void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts,
+                           int outside_response) {
+  if (outside_response < 0 || outside_response > 4)
+    throw InputError(fmt::format("the response outside the image must be 0..4, not {}", outside_response));
   auto& k = *kernels_;
   const cv::Size full = params_.use_colour ? frame.bgr.size() : frame.depth_mm.size();
   // The linear memories of a level are bound whole (a storage buffer here, a texel buffer in
@@ -77,16 +80,17 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
     const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
     const uint32_t word_column_groups = groupsFor(words_per_row * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
-    // Linear memories: padding cells are never written, so zero the buffer only when its
-    // layout changes.
+    // Linear memories: padding cells are never written, so fill the buffer with the response
+    // outside the image (a nibble per cell) only when its layout or that response changes.
     const LinearMemoryLayout& layout = layouts[l];
     const bool same = L.layout.T == layout.T && L.layout.width == layout.width && L.layout.height == layout.height &&
                       L.layout.pad == layout.pad && L.layout.stride == layout.stride && L.layout.rows == layout.rows &&
-                      L.memory.size() == memoryBytes(layout);
+                      L.memory.size() == memoryBytes(layout) && L.outside_response == outside_response;
     if (!same) {
       L.memory = Buffer(ctx_, memoryBytes(layout));
-      batch.fill(L.memory, 0u);
+      batch.fill(L.memory, static_cast<uint32_t>(outside_response) * 0x11111111u);
       L.layout = layout;
+      L.outside_response = outside_response;
     }
     L.spread.reserve(ctx_, label_bytes);
     L.spread_rows.reserve(ctx_, label_bytes);
@@ -95,7 +99,8 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, word_groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, word_column_groups);
-      const int32_t lpush[7] = {L.size.width, L.size.height, layout.T, layout.pad, layout.stride, layout.rows, m};
+      const int32_t lpush[8] = {L.size.width, L.size.height, layout.T,          layout.pad,
+                                layout.stride, layout.rows, outside_response, m};
       // One invocation per 16 aligned padded cells of a pixel row and grid column
       // (response_linearize.comp).
       const int cells_x = (L.size.width + layout.T - 1) / layout.T;

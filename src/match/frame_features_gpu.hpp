@@ -15,8 +15,10 @@ class FrameFeatures {
   FrameFeatures(const GpuContext& ctx, const FeatureParams& params);
   ~FrameFeatures();
 
-  /// Records uploads and kernels for `frame` into `batch`; linear memories use `layouts`.
-  void record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts);
+  /// Records uploads and kernels for `frame` into `batch`; linear memories use `layouts`, and
+  /// their cells outside the image hold `outside_response` (MatchParams) in every bin.
+  void record(Batch& batch, const LinemodFrame& frame, const std::vector<LinearMemoryLayout>& layouts,
+              int outside_response);
 
   /// Only the quantized labels of every level (no spreading, no linear memories), and with
   /// `magnitudes` the colour gradient's squared magnitude per pixel too: what training picks
@@ -44,7 +46,8 @@ class FrameFeatures {
     Buffer labels[kModalityCount];
     Buffer spread_rows, spread;
     Buffer memory;
-    LinearMemoryLayout layout;  // of `memory` as last zeroed
+    LinearMemoryLayout layout;  // of `memory` as last filled
+    int outside_response = 0;   // what the fill left in its padding cells
   };
   struct Kernels;
   const GpuContext& ctx_;

@@ -32,16 +32,18 @@ inline float similarityPercent(int raw_score, int feature_count) {
 
 /// Coarse-level positions of a template: the cell positions whose template centre lies in
 /// the image (OpenCV only tries templates lying wholly inside, and loses the border), less
-/// those that cannot pass the threshold. A feature outside the image responds 0 and a feature
-/// scores at most 4, so a position with fewer than raw_threshold / 4 + 1 features inside can
-/// never score above `raw_threshold`; the range is trimmed, per axis, to the columns and rows
-/// with enough features inside. At 80 % that is 90 % of the features, close to OpenCV's
-/// wholly-inside range, yet a template still finds objects cut by the border.
+/// those that cannot pass the threshold. A feature outside the image responds
+/// `outside_response` (MatchParams) and a feature inside scores at most 4, so a position
+/// with `inside` features of n scores at most 4 inside + outside_response (n - inside); the
+/// range is trimmed, per axis, to the columns and rows where that can exceed
+/// `raw_threshold`. With 0 and 80 % that is 90 % of the features inside, close to OpenCV's
+/// wholly-inside range.
 struct CoarseRange {
   int c_lo = 0, r_lo = 0;  ///< first cell column / row (may be negative)
   int columns = 0, rows = 0;  ///< 0 when no position can pass
 };
-CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold);
+CoarseRange coarseRange(const TemplateLevel& level, const LinearMemoryLayout& layout, int raw_threshold,
+                        int outside_response);
 
 /// Linear-memory layouts of every level for `templates` on a `width` x `height` frame.
 std::vector<LinearMemoryLayout> makeLayouts(const std::vector<LinemodTemplate>& templates,

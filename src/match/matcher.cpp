@@ -109,7 +109,7 @@ void LinemodMatcher::submitFrame(const LinemodFrame& frame) {
   t0 = std::chrono::steady_clock::now();
   pending_.timestamps = batch.timestamps();
   if (pending_.timestamps) pending_.features_begin = batch.timestamp();
-  features_->record(batch, frame, layouts_);
+  features_->record(batch, frame, layouts_, params_.outside_response);
   if (pending_.timestamps) pending_.features_end = batch.timestamp();
   pending_.features_record_ms = msSince(t0);
   if (!pending_.timestamps) {

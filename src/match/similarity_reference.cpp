@@ -99,7 +99,7 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
   // Linear memories of every level.
   std::vector<std::vector<uint8_t>> memories(pyramid.size());
   for (std::size_t l = 0; l < pyramid.size(); ++l) {
-    memories[l].assign(layouts[l].total_bytes(), 0);
+    memories[l].assign(layouts[l].total_bytes(), static_cast<uint8_t>(params.outside_response));
     for (int m = 0; m < kModalityCount; ++m)
       if (!pyramid[l].labels[m].empty())
         linearizeResponseMaps(computeResponseMaps(spreadLabels(pyramid[l].labels[m], layouts[l].T)), m, layouts[l],
@@ -114,7 +114,7 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
   for (std::size_t ti = 0; ti < templates.size(); ++ti) {
     const auto& level = templates[ti].levels[coarse];
     const int threshold = match::rawThreshold(static_cast<int>(level.features.size()), params.threshold);
-    const auto range = match::coarseRange(level, cl, threshold);
+    const auto range = match::coarseRange(level, cl, threshold, params.outside_response);
     for (int r = range.r_lo; r < range.r_lo + range.rows; ++r)
       for (int c0 = range.c_lo; c0 < range.c_lo + range.columns; c0 += match::kRefineWindow) {
         scoreRow(memories[coarse], cl, level, r, c0, scores);

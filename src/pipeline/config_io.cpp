@@ -23,6 +23,8 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
   return {
       {"match", "threshold", "LINEMOD similarity a match needs, percent", &p.match.threshold},
       {"match", "depth_pruning", "score templates only where the scene depth suits their distance", &p.match.depth_pruning},
+      {"match", "outside_response", "response a template feature outside the image counts, 0..4",
+       &p.match.outside_response},
       {"cluster", "position_step_px", "clustering cell s_im, pixels", &p.cluster.position_step_px},
       {"cluster", "min_templates", "smallest cluster tau_c, templates", &p.cluster.min_templates},
       {"score", "depth_unit_m", "alpha = exp(-depth error / unit), metres", &p.score.depth_unit_m},

@@ -162,6 +162,9 @@ SensorParams sensorProfile(const std::string& name_or_file) {
 void validateDetectorParams(const DetectorParams& p) {
   if (!(p.match.threshold > 0.f && p.match.threshold <= 100.f))
     throw InputError(fmt::format("the match threshold must be in (0, 100] percent, not {}", p.match.threshold));
+  if (p.match.outside_response < 0 || p.match.outside_response > 4)
+    throw InputError(fmt::format("the response of a feature outside the image must be 0..4, not {}",
+                                 p.match.outside_response));
   if (p.cluster.position_step_px < 1 || p.cluster.min_templates < 1)
     throw InputError(fmt::format("the clustering cell ({} px) and the smallest cluster ({} templates) must be 1 or more",
                                  p.cluster.position_step_px, p.cluster.min_templates));
