@@ -107,9 +107,10 @@ struct InitialPoseParams {
   /// starts a hypothesis from this many of its largest rotation groups, as small parts do. Their
   /// clusters mix look-alike views from several hemispheres (a milk jug lying on its flank
   /// matched end for end, or turned 57 degrees about its long axis, in the largest groups), and
-  /// the right group is often the third or fourth. Default banks of objects of 10 cm and more
-  /// (one resting pose) keep one start. 1: the largest only.
-  int resting_poses_starts = 4;
+  /// the right group is often the third or fourth, and now and then the sixth or eighth (8
+  /// against 4 on the lying set: docs/pipeline.md, stage 6). Default banks of objects of 10 cm
+  /// and more (one resting pose) keep one start. 1: the largest only.
+  int resting_poses_starts = 8;
   /// Where stage 6 puts a hypothesis: the template's range plus the cluster score's depth
   /// offset is a z-range, and off the optical axis the range along the ray is longer by
   /// 1 / cos(theta) (rangeOnRay): true converts it. Off (today's default), an object 20
