@@ -150,7 +150,8 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         const int n = static_cast<int>(level.features.size());
         const int threshold = match::rawThreshold(n, params.threshold);
         // Only the coarse level scans a range; the finer one scores the units of refinement.
-        const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response) : match::CoarseRange{};
+        const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response)
+                                           : match::CoarseRange{};
         const match::TemplateDepthGate gate = gates.empty() ? match::TemplateDepthGate{} : gates[t];
         headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
                                              threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
