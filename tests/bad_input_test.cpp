@@ -168,6 +168,11 @@ TEST(BadInputTemplates, AreRejectedWithAMessage) {
   bad.T = {5, 8, 12};
   EXPECT_THROW(validateFeatureParams(bad), InputError);
   EXPECT_THROW(LinemodMatcher(test::context(), {}, MatchParams{0.0f}), InputError);
+  MatchParams outside;
+  outside.outside_response = 5;
+  test::expectInputError([&] { LinemodMatcher(test::context(), {}, outside); }, {"outside the image", "0..4", "5"});
+  test::expectInputError([&] { matchTemplatesReference({}, someTemplates(), p, outside); },
+                         {"outside the image", "0..4", "5"});
 }
 
 // ---- files: missing, empty, truncated ---------------------------------------------------

@@ -20,8 +20,7 @@ using util::msSince;
 LinemodMatcher::LinemodMatcher(GpuContext& context, FeatureParams feature_params, MatchParams params)
     : context_(context), feature_params_(std::move(feature_params)), params_(params) {
   validateFeatureParams(feature_params_);
-  if (!(params_.threshold > 0.0f && params_.threshold <= 100.0f))
-    throw InputError("match threshold " + std::to_string(params_.threshold) + " % is outside (0, 100]");
+  validateMatchParams(params_);
   features_ = std::make_unique<gpu::FrameFeatures>(context_, feature_params_);
   similarity_ = std::make_unique<gpu::Similarity>(context_);
 }

@@ -33,6 +33,10 @@ struct DepthPruning {
   match::AnchorDepthCells cells;
 };
 
+/// Throws InputError for a threshold outside (0, 100] % or an outside response outside 0..4:
+/// the checks the GPU matcher and the CPU reference share.
+void validateMatchParams(const MatchParams& params);
+
 /// Stage 2 on the CPU from the quantized pyramid: the reference the GPU matcher is tested
 /// against. With `pruning`, only coarse positions that pass match::positionPasses.
 std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& pyramid,

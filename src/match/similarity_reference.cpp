@@ -67,6 +67,14 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
 
 }  // namespace match
 
+void validateMatchParams(const MatchParams& params) {
+  if (!(params.threshold > 0.0f && params.threshold <= 100.0f))
+    throw InputError("match threshold " + std::to_string(params.threshold) + " % is outside (0, 100]");
+  if (params.outside_response < 0 || params.outside_response > 4)
+    throw InputError("the response of a feature outside the image must be 0..4, not " +
+                     std::to_string(params.outside_response));
+}
+
 namespace {
 
 /// Sum of responses of `level`'s features for a template at cells (r, c) .. (r, c + 15).
@@ -90,8 +98,7 @@ std::vector<Match> matchTemplatesReference(const std::vector<QuantizedLevel>& py
   if (pruning && pruning->gates.size() != templates.size())
     throw InputError("depth pruning needs one gate per template");
   validateTemplates(templates, fp);
-  if (!(params.threshold > 0.0f && params.threshold <= 100.0f))
-    throw InputError("match threshold " + std::to_string(params.threshold) + " % is outside (0, 100]");
+  validateMatchParams(params);
   if (pyramid.size() != fp.T.size()) throw InputError("quantized pyramid has the wrong number of levels");
   const cv::Mat& level0 = pyramid[0].labels[fp.use_colour ? 0 : 1];
   const auto layouts = match::makeLayouts(templates, fp, level0.cols, level0.rows);
