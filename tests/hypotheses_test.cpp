@@ -16,6 +16,7 @@
 #include "synth/scene.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
@@ -228,6 +229,52 @@ TEST(Nms, KeepsASmallPartsNeighbouringViews) {
   // The same share as everyone else when asked.
   p.small_part_radius_fraction = p.radius_fraction;
   EXPECT_EQ(suppressNonMaxima(hyps, part, 500, p).size(), 1u);
+}
+
+// A wrong view that fits a little better hides the right one a cell away (a cluster on the
+// edge of a box beside a lying cup): each survivor of an object of 10 cm and more brings along
+// the best hypothesis it suppressed that shows another view and fits at least half as well.
+TEST(Nms, EachSurvivorBringsAlongItsBestRunnerUpOfAnotherView) {
+  // Three views: upright, turned 90 degrees, turned 10 degrees (the same view, for this).
+  TemplateBank object = fakeBank(3, {0.5f}, 0.2f);
+  object.templates[1].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI) / 2, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  object.templates[2].pose.R = Eigen::AngleAxisf(0.1745f, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  const auto showing = [](Hypothesis h, int view) {
+    h.members = {ClusterMember{}};
+    h.members[0].template_index = view;
+    h.best_member = 0;
+    return h;
+  };
+  NmsParams p;
+  p.across_objects = false;
+  ASSERT_FLOAT_EQ(p.runner_up_share, 0.5f);
+  const std::vector<TemplateBank> banks{object};
+  // 0.2 m at 0.5 m with fx 500: 200 px across, so a 100 px radius.
+  const std::vector<Hypothesis> all{showing(scored(100, 100, 0.9f), 0),   // the survivor
+                                    showing(scored(120, 100, 0.7f), 2),   // the same view: no
+                                    showing(scored(110, 100, 0.6f), 1),   // another view: the runner-up
+                                    showing(scored(130, 100, 0.5f), 1),   // another view, but less
+                                    showing(scored(90, 100, 0.4f), 1),    // under half the survivor's
+                                    showing(scored(400, 100, 0.3f), 1)};  // a survivor of its own
+  const auto kept = suppressNonMaxima(all, banks, 500, p);
+  ASSERT_EQ(kept.size(), 2u);
+  auto ups = runnersUp(all, kept, banks, 500, p);
+  ASSERT_EQ(ups.size(), 1u);
+  EXPECT_FLOAT_EQ(ups[0].x, 110.f);
+  EXPECT_FLOAT_EQ(ups[0].score, 0.6f);
+  // A higher share asks more of it; 0 turns them off.
+  p.runner_up_share = 0.7f;
+  EXPECT_TRUE(runnersUp(all, kept, banks, 500, p).empty());
+  p.runner_up_share = 0.f;
+  EXPECT_TRUE(runnersUp(all, kept, banks, 500, p).empty());
+  // Small parts have their own narrow NMS instead (small_part_radius_fraction).
+  p.runner_up_share = 0.5f;
+  TemplateBank part = object;
+  part.diameter = 0.04f;
+  EXPECT_TRUE(runnersUp(all, suppressNonMaxima(all, {part}, 500, p), {part}, 500, p).empty());
+  // A config file sets it, within 0..1.
+  EXPECT_FLOAT_EQ(parseConfig(R"({"nms": {"runner_up_share": 0}})", "t").nms.runner_up_share, 0.f);
+  EXPECT_THROW(parseConfig(R"({"nms": {"runner_up_share": 1.5}})", "t"), InputError);
 }
 
 TEST(ViewingRay, TurnsTheOpticalAxisOntoThePixelsRay) {

@@ -85,6 +85,12 @@ struct NmsParams {
   /// of one instance (small_part_pose_candidates gives room for them). Without stages 6-8
   /// (--no-pose) radius_fraction holds for every object.
   float small_part_radius_fraction = 0.1f;
+  /// Objects of 10 cm and more, with stages 6-8: each survivor brings along the best
+  /// hypothesis it suppressed whose gamma is at least this share of its own and whose best
+  /// view is turned more than 30 degrees from the survivor's (runnersUp). A wrong view that
+  /// fits a little better (a cluster on the edge of a box beside a lying cup, or a carton seen
+  /// from its other side) otherwise hides the right one a cell away. 0: none.
+  float runner_up_share = 0.5f;
 };
 
 struct InitialPoseParams {

@@ -168,4 +168,39 @@ Eigen::Matrix3f viewingRayRotation(float x, float y, const Camera& camera) {
   return Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), ray.normalized()).toRotationMatrix();
 }
 
+std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std::vector<Hypothesis>& kept,
+                                  const std::vector<TemplateBank>& banks, double fx, const NmsParams& params) {
+  if (!(params.runner_up_share > 0.f)) return {};
+  const float min_angle = 30.f * static_cast<float>(M_PI) / 180.f;
+  const auto bestView = [&](const Hypothesis& h) -> const Eigen::Matrix3f& {
+    const auto& m = h.members[static_cast<std::size_t>(h.best_member)];
+    return banks[static_cast<std::size_t>(h.bank)].templates[static_cast<std::size_t>(m.template_index)].pose.R;
+  };
+  std::vector<int> best(kept.size(), -1);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const Hypothesis& h = all[i];
+    if (h.best_member < 0 || isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter)) continue;
+    // The survivor that suppressed h: the first (best) one of its object within the radius,
+    // as in suppressNonMaxima. h itself, a survivor, is the first within reach of itself.
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+      const Hypothesis& s = kept[k];
+      if (s.bank != h.bank || s.best_member < 0) continue;
+      const float r = params.radius_px > 0.f ? params.radius_px
+                                             : params.radius_fraction * std::max(projectedDiameter(h, banks, fx),
+                                                                                 projectedDiameter(s, banks, fx));
+      const float dx = h.x - s.x, dy = h.y - s.y;
+      if (dx * dx + dy * dy >= r * r) continue;
+      const bool another_view = Eigen::AngleAxisf(bestView(h).transpose() * bestView(s)).angle() > min_angle;
+      if (another_view && h.score >= params.runner_up_share * s.score &&
+          (best[k] < 0 || h.score > all[static_cast<std::size_t>(best[k])].score))
+        best[k] = static_cast<int>(i);
+      break;
+    }
+  }
+  std::vector<Hypothesis> out;
+  for (const int i : best)
+    if (i >= 0) out.push_back(all[static_cast<std::size_t>(i)]);
+  return out;
+}
+
 }  // namespace vkpose

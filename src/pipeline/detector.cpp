@@ -283,6 +283,8 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
     // compete after verification, in 3D.
     NmsParams nms = params_.nms;
     nms.across_objects = false;
+    std::vector<Hypothesis> all;  // for the runners-up
+    if (nms.runner_up_share > 0.f) all = hypotheses;
     hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, nms);
     std::vector<int> taken(banks_.size(), 0);
     std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
@@ -291,6 +293,8 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
                                                         : params_.pose_candidates_per_object;
       return taken[b]++ >= most;
     });
+    // After the cap: a runner-up rides with a survivor that gets a pose.
+    for (auto& h : runnersUp(all, hypotheses, banks_, camera.fx, nms)) hypotheses.push_back(std::move(h));
   } else {
     // No verification to remove a small part's duplicates: one hypothesis a place for all.
     NmsParams nms = params_.nms;

@@ -170,6 +170,8 @@ void validateDetectorParams(const DetectorParams& p) {
                                  p.cluster.position_step_px, p.cluster.min_templates));
   if (!(p.nms.radius_px >= 0.f) || !(p.nms.radius_fraction > 0.f) || !(p.nms.small_part_radius_fraction > 0.f))
     throw InputError("the NMS radius must be 0 or more pixels and its fractions more than 0");
+  if (!(p.nms.runner_up_share >= 0.f && p.nms.runner_up_share <= 1.f))
+    throw InputError(fmt::format("the NMS runner-up share must be in [0, 1], not {}", p.nms.runner_up_share));
   if (!(p.nms.template_weight >= 0.f && p.nms.template_weight <= 4.f))
     throw InputError(fmt::format("the NMS template weight must be in [0, 4], not {}", p.nms.template_weight));
   validateScoreParams(p.score);
