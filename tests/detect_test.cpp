@@ -96,8 +96,9 @@ TEST(DetectIcbin, VerifiedPosesSitOnTheCupsTheHypothesesFound) {
   VKPOSE_REQUIRE_SHARED_DATA();
   const auto& hyps = icbinScene2().result.detections;  // on distinct cups (the test above)
   const DetectionResult& r = icbinScene2Poses().result;
-  // Measured: 5 accepted of 12 candidates; cups pressed against cups at the same depth show
-  // too little of a depth step around their outline and are rejected (see VerifyParams).
+  // Measured with the CLI's bank: 8 accepted of 36 candidates (6 of 18 without stage 5's
+  // runners-up); cups pressed against cups at the same depth show too little of a depth step
+  // around their outline and are rejected (see VerifyParams).
   EXPECT_GE(r.detections.size(), 4u);
   for (const Detection& d : r.detections) {
     EXPECT_TRUE(d.verified);
@@ -105,7 +106,13 @@ TEST(DetectIcbin, VerifiedPosesSitOnTheCupsTheHypothesesFound) {
     for (const auto& h : hyps) on_cup = on_cup || std::hypot(d.x - h.x, d.y - h.y) < 20.f;
     EXPECT_TRUE(on_cup) << "a pose at " << d.x << "," << d.y << " is on none of the cups";
     EXPECT_GT(d.collision_rate, 0.4f);
-    EXPECT_LT(d.icp_fitness, 30e-6);  // mean squared pair distance: under (5.5 mm)^2
+    // Mean squared pair distance under (5.5 mm)^2 where the score says the pose is sure (0.5,
+    // docs/evaluation.md). Below it a pose may fit more loosely: since stage 5's runners-up
+    // (2026-11-28), a cup leaning at the back, half hidden, is found at score 0.22 with 38.7 mm^2
+    // (see-through 0.13, depth fit 0.74); the others fit within 6-15 mm^2.
+    if (d.score >= 0.5f) {
+      EXPECT_LT(d.icp_fitness, 30e-6);
+    }
     // The outline of the posed model covers the detection's centre.
     const auto outline = silhouette(icbinCupBank().mesh, d.pose, loadCamera(test::sharedData() + "/icbin/camera.json"));
     ASSERT_FALSE(outline.empty());
