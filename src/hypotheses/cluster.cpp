@@ -108,6 +108,24 @@ float projectedDiameter(const Hypothesis& h, const std::vector<TemplateBank>& ba
   return h.distance > 0.f ? static_cast<float>(fx) * d / h.distance : 0.f;
 }
 
+namespace {
+
+/// Whether NMS lets `kept` suppress `h` (the radius suppressNonMaxima and runnersUp share).
+bool withinSuppressionRadius(const Hypothesis& h, const Hypothesis& kept, const std::vector<TemplateBank>& banks,
+                             double fx, const NmsParams& params) {
+  // Within one small part only: across objects, one place holds one object.
+  const float fraction = kept.bank == h.bank && isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter)
+                             ? params.small_part_radius_fraction
+                             : params.radius_fraction;
+  const float r = params.radius_px > 0.f
+                      ? params.radius_px
+                      : fraction * std::max(projectedDiameter(h, banks, fx), projectedDiameter(kept, banks, fx));
+  const float dx = h.x - kept.x, dy = h.y - kept.y;
+  return dx * dx + dy * dy < r * r;
+}
+
+}  // namespace
+
 float nmsRank(const Hypothesis& h, const std::vector<TemplateBank>& banks, const NmsParams& params) {
   if (params.template_weight == 0.f || !isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter))
     return h.score;
@@ -130,22 +148,12 @@ std::vector<Hypothesis> suppressNonMaxima(std::vector<Hypothesis> hypotheses, co
     return std::tie(b.first, a.second.bank, a.second.y, a.second.x) <
            std::tie(a.first, b.second.bank, b.second.y, b.second.x);
   });
-  const auto smallPart = [&](const Hypothesis& h) {
-    return isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter);
-  };
   std::vector<Hypothesis> kept;
   for (auto& [rank, h] : ranked) {
     bool suppressed = false;
     for (const auto& k : kept) {
       if (!params.across_objects && k.bank != h.bank) continue;
-      // Within one small part only: across objects, one place holds one object.
-      const float fraction = k.bank == h.bank && smallPart(h) ? params.small_part_radius_fraction
-                                                              : params.radius_fraction;
-      const float r = params.radius_px > 0.f ? params.radius_px
-                                             : fraction * std::max(projectedDiameter(h, banks, fx),
-                                                                   projectedDiameter(k, banks, fx));
-      const float dx = h.x - k.x, dy = h.y - k.y;
-      if (dx * dx + dy * dy < r * r) {
+      if (withinSuppressionRadius(h, k, banks, fx, params)) {
         suppressed = true;
         break;
       }
@@ -184,12 +192,7 @@ std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std:
     // as in suppressNonMaxima. h itself, a survivor, is the first within reach of itself.
     for (std::size_t k = 0; k < kept.size(); ++k) {
       const Hypothesis& s = kept[k];
-      if (s.bank != h.bank || s.best_member < 0) continue;
-      const float r = params.radius_px > 0.f ? params.radius_px
-                                             : params.radius_fraction * std::max(projectedDiameter(h, banks, fx),
-                                                                                 projectedDiameter(s, banks, fx));
-      const float dx = h.x - s.x, dy = h.y - s.y;
-      if (dx * dx + dy * dy >= r * r) continue;
+      if (s.bank != h.bank || s.best_member < 0 || !withinSuppressionRadius(h, s, banks, fx, params)) continue;
       const bool another_view = Eigen::AngleAxisf(bestView(h).transpose() * bestView(s)).angle() > min_angle;
       if (another_view && h.score >= params.runner_up_share * s.score &&
           (best[k] < 0 || h.score > all[static_cast<std::size_t>(best[k])].score))
