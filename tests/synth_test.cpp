@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -264,6 +265,40 @@ TEST(SynthScene, AnObjectTheBorderCutsInHalfIsHalfVisible) {
   EXPECT_NEAR(r.visibleFraction(0), 0.5f, 0.03f);
   EXPECT_GT(r.full_pixels[0], cv::countNonZero(r.full_masks[0]));
   EXPECT_FLOAT_EQ(r.visibleFraction(1), 1.f);
+}
+
+TEST(SynthScene, ABinFloorSeenFromCloseIsWhole) {
+  // A 1 m floor tilted 60 degrees, its centre 0.3 m in front of the camera: its near half
+  // reaches behind the camera, whose triangles the rasterizer drops. Tiled, every pixel whose
+  // ray meets the floor's top face (1 cm from its edges) shows the floor.
+  const float side = 1.f, thickness = 0.01f;
+  const Mesh floor = cuboidMesh({side, side, thickness}, {0.4f, 0.3f, 0.3f}, 0.05f);
+  SceneObject o;
+  o.mesh = &floor;
+  o.pose.R = Eigen::AngleAxisf(std::numbers::pi_v<float> / 3.f, Eigen::Vector3f::UnitX()).toRotationMatrix() *
+             Eigen::AngleAxisf(std::numbers::pi_v<float>, Eigen::Vector3f::UnitX()).toRotationMatrix();  // top face (+z) to the camera
+  o.pose.t = Eigen::Vector3f(0.f, 0.f, 0.3f);
+  const Camera camera;
+  const SceneRendering r = renderScene(test::context(), {o}, camera);
+  const Eigen::Vector3f normal = o.pose.R.col(2), top = o.pose.t + 0.5f * thickness * normal;
+  ASSERT_LT((o.pose.R * Eigen::Vector3f(0.f, -0.5f * side, 0.f) + o.pose.t).z() *
+                (o.pose.R * Eigen::Vector3f(0.f, 0.5f * side, 0.f) + o.pose.t).z(),
+            0.f)
+      << "one edge of the floor must lie behind the camera";
+  int expected = 0, missing = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
+                                static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+      const float along = normal.dot(top) / normal.dot(ray);
+      if (!(along > 0.f)) continue;
+      const Eigen::Vector3f in_object = o.pose.R.transpose() * (along * ray - o.pose.t);
+      if (std::abs(in_object.x()) > 0.5f * side - 0.01f || std::abs(in_object.y()) > 0.5f * side - 0.01f) continue;
+      ++expected;
+      missing += r.depth.at<float>(y, x) > 0.f ? 0 : 1;
+    }
+  EXPECT_GT(expected, camera.width * camera.height / 4);
+  EXPECT_EQ(missing, 0) << "of " << expected << " pixels on the floor";
 }
 
 TEST(SynthTejani, PosesAreUsedVerbatim) {

@@ -117,11 +117,15 @@ Mesh planeMesh(float size, float grey) {
   return m;
 }
 
-Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb) {
+Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb, float max_tile_m) {
   if (!(size.minCoeff() > 0.f) || size.maxCoeff() > 10.f) throw InputError("cuboid sides must be in (0, 10] metres");
+  if (!(max_tile_m >= 0.f)) throw InputError("a cuboid's tile size must be 0 (none) or positive");
   Mesh m;
   m.name = "cuboid";
   const Eigen::Vector3f h = 0.5f * size;
+  const auto tiles = [&](int axis) {
+    return max_tile_m > 0.f ? std::max(1, static_cast<int>(std::ceil(size[axis] / max_tile_m))) : 1;
+  };
   for (int axis = 0; axis < 3; ++axis)
     for (const float sign : {-1.f, 1.f}) {
       // The face at sign * h[axis]; u, v span it so that (u x v) points outwards.
@@ -130,13 +134,20 @@ Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb) {
       n[axis] = sign;
       u[a] = h[a];
       v[b] = sign * h[b];
-      const int base = static_cast<int>(m.vertices.size());
-      for (const auto& [su, sv] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}}) {
-        m.vertices.push_back(n.cwiseProduct(h) + su * u + sv * v);
-        m.normals.push_back(n);
-      }
-      m.faces.emplace_back(base, base + 1, base + 2);
-      m.faces.emplace_back(base, base + 2, base + 3);
+      const int nu = tiles(a), nv = tiles(b), base = static_cast<int>(m.vertices.size());
+      for (int i = 0; i <= nv; ++i)
+        for (int j = 0; j <= nu; ++j) {
+          const float su = -1.f + 2.f * static_cast<float>(j) / static_cast<float>(nu);
+          const float sv = -1.f + 2.f * static_cast<float>(i) / static_cast<float>(nv);
+          m.vertices.push_back(n.cwiseProduct(h) + su * u + sv * v);
+          m.normals.push_back(n);
+        }
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nu; ++j) {
+          const int c00 = base + i * (nu + 1) + j, c10 = c00 + 1, c01 = c00 + nu + 1, c11 = c01 + 1;
+          m.faces.emplace_back(c00, c10, c11);
+          m.faces.emplace_back(c00, c11, c01);
+        }
     }
   m.colours.assign(m.vertices.size(), rgb);
   finishMesh(m);

@@ -122,6 +122,9 @@ void addTable(ImageScene& s, const Camera& camera, float z, std::mt19937& rng) {
   s.add(std::move(table), at);
 }
 
+/// Bin walls and floor are made of tiles this large (see cuboidMesh).
+constexpr float kBinTileM = 0.05f;
+
 /// A box or a cylinder of a random size and colour: things on a table that are not the objects,
 /// `scale` times the size of things that stand among 10-30 cm objects.
 Mesh clutterMesh(std::mt19937& rng, float scale) {
@@ -180,12 +183,13 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
     for (const OrientedBox& wall : binWalls(placement)) {
       Pose at;
       at.t = wall.centre;
-      s.add(cuboidMesh(2.f * wall.half, colour), at);
+      s.add(cuboidMesh(2.f * wall.half, colour, kBinTileM), at);
     }
     const float floor = placement.bin_wall_thickness_m;
     Pose at;
     at.t.z() = -0.5f * floor;
-    s.add(cuboidMesh({placement.bin_inner_m.x() + 2 * floor, placement.bin_inner_m.y() + 2 * floor, floor}, colour),
+    s.add(cuboidMesh({placement.bin_inner_m.x() + 2 * floor, placement.bin_inner_m.y() + 2 * floor, floor}, colour,
+                     kBinTileM),
           at);
     addTable(s, p.camera, -floor - 0.001f, rng);
   } else {
