@@ -13,7 +13,12 @@ void main() {
   Triangle t;
   if (!setupTriangle(view, f, t)) return;
   uint base = view * uint(pc.width * pc.height);
-  for (int y = t.box.y; y <= t.box.w; ++y)
+  // The box's rows are shared among the dispatch's z groups, each invocation taking one band:
+  // lavapipe ends an invocation's loops after 65,535 iterations in all, which cut off the
+  // lower rows of a triangle whose box held more pixels (src/render/renderer.cpp, rasterBands).
+  const int bands = int(gl_NumWorkGroups.z), rows = (t.box.w - t.box.y + bands) / bands;
+  const int y0 = t.box.y + int(gl_WorkGroupID.z) * rows, y1 = min(t.box.w, y0 + rows - 1);
+  for (int y = y0; y <= y1; ++y)
     for (int x = t.box.x; x <= t.box.z; ++x) {
       vec3 e = edgesAt(t, x, y);
       if (e.x < 0.0 || e.y < 0.0 || e.z < 0.0) continue;

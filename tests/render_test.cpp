@@ -139,6 +139,28 @@ TEST(Render, TrianglesWiderThanTwoThousandPixelsMatchTheReference) {
   EXPECT_GE(g.min_normal_dot, 0.999f);
 }
 
+// lavapipe ends a shader invocation's loops after 65,535 iterations in all, and the raster
+// pass loops over its triangle's pixel box: a triangle of a larger box lost its lower rows (a
+// third of a bin floor 0.8 m away) until the rows were shared among invocations. A 60 x 45 cm
+// face 0.6 m away fills most of a 640 x 480 frame; each of its triangles has a box of about
+// 250,000 pixels.
+TEST(Render, TrianglesOfMoreThanLavapipesLoopLimitInPixelsRenderWhole) {
+  const Mesh board = test::boxMesh({0.6f, 0.45f, 0.01f});
+  MeshRenderer renderer(test::context(), board);
+  const Camera cam;
+  ASSERT_EQ(cam.width * cam.height, 640 * 480);
+  Pose pose;
+  pose.R = Eigen::AngleAxisf(0.2f, Eigen::Vector3f(1.f, 0.3f, 0.f).normalized()).toRotationMatrix();
+  pose.t = Eigen::Vector3f(0.01f, -0.02f, 0.6f);
+  const Rendering gpu = renderer.render(cam, {pose})[0];
+  const Rendering ref = renderReference(board, cam, pose);
+  ASSERT_GT(cv::countNonZero(ref.mask()), 200000);
+  const Agreement g = compare(gpu, ref);
+  EXPECT_GE(g.mask_agree, 0.9995);
+  EXPECT_LE(g.max_depth_rel, 1e-5f);
+  EXPECT_GE(g.min_normal_dot, 0.999f);
+}
+
 /// Distance along the pixel's ray (z) to an axis-aligned box under `pose`, or 0 for a miss.
 float rayCastBox(const Camera& cam, const Pose& pose, const Eigen::Vector3f& half, int x, int y) {
   const Eigen::Vector3f ray_cam((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);

@@ -136,6 +136,20 @@ struct RasterPush {
   uint32_t face_count, flags;
 };
 constexpr std::size_t kBatchBytes = 96u << 20;  // per-batch output budget
+
+/// lavapipe (llvmpipe's gallivm) ends an invocation's loops after 65,535 iterations counted
+/// over all of them together (LP_MAX_TGSI_LOOP_ITERATIONS); a GPU has no such limit. The
+/// raster pass loops over its triangle's pixel box, so a box of more pixels lost its lower
+/// rows (a bin floor 0.8 m away, 340 x 270 px, a third of it). The box's rows are shared
+/// among this many invocations (the dispatch's z groups), each within the budget: 1 for a
+/// template window of up to about 93 x 640 pixels, 6 for a 640 x 480 frame.
+uint32_t rasterBands(const Camera& camera) {
+  constexpr uint32_t kLoopBudget = 60000;  // a row costs width + 2 steps (measured); under 65,535
+  const auto width = static_cast<uint32_t>(camera.width), height = static_cast<uint32_t>(camera.height);
+  uint32_t bands = 1;
+  while ((height + bands - 1) / bands * (width + 2) > kLoopBudget && (height + bands - 1) / bands > 1) ++bands;
+  return bands;
+}
 constexpr std::size_t kMaxViewsPerBatch = 256;
 }  // namespace
 
@@ -240,7 +254,7 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     batch.upload(w.poses, rows.data(), rows.size() * 4);
     batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
     batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
-                   static_cast<uint32_t>(n));
+                   static_cast<uint32_t>(n), rasterBands(camera));
     batch.dispatch(m.resolve,
                    {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
                    push, gpu::groupsFor(pixels, 64), static_cast<uint32_t>(n));

@@ -134,19 +134,19 @@ Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb, float m
       n[axis] = sign;
       u[a] = h[a];
       v[b] = sign * h[b];
-      const int nu = tiles(a), nv = tiles(b), base = static_cast<int>(m.vertices.size());
-      for (int i = 0; i <= nv; ++i)
-        for (int j = 0; j <= nu; ++j) {
-          const float su = -1.f + 2.f * static_cast<float>(j) / static_cast<float>(nu);
-          const float sv = -1.f + 2.f * static_cast<float>(i) / static_cast<float>(nv);
-          m.vertices.push_back(n.cwiseProduct(h) + su * u + sv * v);
-          m.normals.push_back(n);
-        }
+      // Each tile its own four corners, in the order an untiled face has always had (the demo's
+      // meshes in assets/ stay byte for byte what they were).
+      const int nu = tiles(a), nv = tiles(b);
+      const auto at = [](int k, int count) { return -1.f + 2.f * static_cast<float>(k) / static_cast<float>(count); };
       for (int i = 0; i < nv; ++i)
         for (int j = 0; j < nu; ++j) {
-          const int c00 = base + i * (nu + 1) + j, c10 = c00 + 1, c01 = c00 + nu + 1, c11 = c01 + 1;
-          m.faces.emplace_back(c00, c10, c11);
-          m.faces.emplace_back(c00, c11, c01);
+          const int base = static_cast<int>(m.vertices.size());
+          for (const auto& [cu, cv] : {std::pair{j, i}, {j + 1, i}, {j + 1, i + 1}, {j, i + 1}}) {
+            m.vertices.push_back(n.cwiseProduct(h) + at(cu, nu) * u + at(cv, nv) * v);
+            m.normals.push_back(n);
+          }
+          m.faces.emplace_back(base, base + 1, base + 2);
+          m.faces.emplace_back(base, base + 2, base + 3);
         }
     }
   m.colours.assign(m.vertices.size(), rgb);

@@ -41,9 +41,8 @@ Mesh planeMesh(float size, float grey = 0.55f);
 
 /// A box of side lengths `size` (metres) centred at the origin, flat-shaded (its own vertices
 /// per face), of one colour (RGB 0..1): clutter, bin walls. With `max_tile_m` > 0 each face is
-/// made of tiles no larger than that, as planeMesh's are: a bin seen from close by has corners
-/// behind the camera, and the rasterizer drops a triangle with such a corner (the bin's floor
-/// went missing in close views and the table showed through it).
+/// made of tiles no larger than that, as planeMesh's are: the rasterizer drops a triangle with
+/// a corner behind the camera, and a bin seen from close by can reach behind it.
 Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb, float max_tile_m = 0.f);
 
 /// A closed cylinder along z centred at the origin, `segments` sides: cans and jars as clutter.
