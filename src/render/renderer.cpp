@@ -146,9 +146,8 @@ constexpr std::size_t kBatchBytes = 96u << 20;  // per-batch output budget
 uint32_t rasterBands(const Camera& camera) {
   constexpr uint32_t kLoopBudget = 60000;  // a row costs width + 2 steps (measured); under 65,535
   const auto width = static_cast<uint32_t>(camera.width), height = static_cast<uint32_t>(camera.height);
-  uint32_t bands = 1;
-  while ((height + bands - 1) / bands * (width + 2) > kLoopBudget && (height + bands - 1) / bands > 1) ++bands;
-  return bands;
+  const uint32_t rows = std::max(1u, kLoopBudget / (width + 2));  // rows a band may take
+  return (height + rows - 1) / rows;
 }
 constexpr std::size_t kMaxViewsPerBatch = 256;
 }  // namespace
