@@ -204,6 +204,23 @@ TEST(BadInputBank, Version1And99AreRefused) {
   }
 }
 
+TEST(BadInputBank, CropsLargerThanTrainingMakesAreRefused) {
+  // The cluster score's kernel loops over a crop's cells; training makes at most 25 x 25.
+  TemplateBank bank = tinyBank();
+  BankTemplate& t = bank.templates[0];
+  const std::string path = scratch() + "/big_crop.vkpb";
+  for (const int cells : {kCropCells + 1, kCropCells + 2}) {
+    t.crop.cols = t.crop.rows = cells;
+    t.crop.depth_01mm.assign(static_cast<std::size_t>(cells * cells), 6750);
+    t.crop.normals.assign(static_cast<std::size_t>(cells * cells * 3), 0);
+    saveBank(bank, path);
+    if (cells == kCropCells + 1)
+      EXPECT_EQ(loadBank(path).templates.at(0).crop.cols, cells);
+    else
+      expectInputError([&] { loadBank(path); }, {"big_crop.vkpb", "crop 26x26", "at most 25x25"});
+  }
+}
+
 TEST(BadInputBank, WrongMagic) {
   std::string bytes = tinyBankBytes();
   bytes[0] = 'X';

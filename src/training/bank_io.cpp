@@ -294,8 +294,13 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
     t.crop.stride = r.get<int32_t>();
     t.crop.cols = r.get<int32_t>();
     t.crop.rows = r.get<int32_t>();
-    if (t.crop.stride < 1 || t.crop.cols < 0 || t.crop.rows < 0 || t.crop.cols > 4096 || t.crop.rows > 4096)
-      r.fail(fmt::format("template {}: crop {}x{} stride {}", i, t.crop.cols, t.crop.rows, t.crop.stride));
+    // Training never makes a crop over kCropCells + 1 cells a side, and the cluster score's
+    // kernel relies on it: its loops over a crop's cells run within lavapipe's 65,535-step
+    // budget an invocation only for crops of about 180 x 180 cells or fewer (docs/measured.md).
+    constexpr int max_cells = kCropCells + 1;
+    if (t.crop.stride < 1 || t.crop.cols < 0 || t.crop.rows < 0 || t.crop.cols > max_cells || t.crop.rows > max_cells)
+      r.fail(fmt::format("template {}: crop {}x{} stride {} (training makes at most {}x{})", i, t.crop.cols,
+                         t.crop.rows, t.crop.stride, max_cells, max_cells));
     const std::size_t cells = static_cast<std::size_t>(t.crop.cols) * t.crop.rows;
     t.crop.depth_01mm = r.getArray<uint16_t>(cells);
     t.crop.normals = r.getArray<int8_t>(cells * 3);
