@@ -28,7 +28,7 @@ for seed in ${seeds[@]}; do
   "$vkpose" eval --dataset "$set" --bank 1="$bank" --method vkpose --method linemod --report "$set-report.json" \
     --pr-curve "$set-pr.svg" --out "$set-results.csv" --force
 done
-# Found instances by how much of each is visible, over every seed (ADD below 0.15 of the
-# diameter, each estimate best score first to the nearest free instance, as `eval` counts):
-# where the misses are (docs/pipeline.md, "Where the small parts' ceiling is").
+# Found instances by how much of each is visible, summed over the seeds' eval reports (each
+# eval prints its own line too): where the misses are (docs/pipeline.md, "Where the small
+# parts' ceiling is").
 python3 "$root/scripts/small_parts.py" visibility "$out" ${seeds[@]}

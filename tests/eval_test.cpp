@@ -257,6 +257,14 @@ TEST(Evaluation, ReportsTheThreeMethodsOnTheLmoFrame) {
     ASSERT_EQ(m.at("objects").size(), 1u) << method;
     const auto& o = m.at("objects").at("8");
     EXPECT_EQ(o.at("tp").get<int>() + o.at("fn").get<int>(), 1) << method;  // one driller in the frame
+    // The driller is 97 % visible: the top bin holds it, found when it is a true positive.
+    for (const auto* bins : {&o.at("by_visibility"), &m.at("by_visibility")}) {
+      ASSERT_EQ(bins->size(), 5u) << method;
+      EXPECT_EQ(bins->at(4).at("instances").get<int>(), 1) << method;
+      EXPECT_EQ(bins->at(4).at("found").get<int>(), o.at("tp").get<int>()) << method;
+      EXPECT_DOUBLE_EQ(bins->at(4).at("visib_fract").at(0).get<double>(), 0.8) << method;
+      EXPECT_EQ(bins->at(0).at("instances").get<int>(), 0) << method;
+    }
   }
   // LINEMOD alone reports every match: far more estimates than instances.
   const auto& linemod = doc.at("methods").at("linemod").at("objects").at("8");
@@ -274,6 +282,8 @@ TEST(Evaluation, ReportsTheThreeMethodsOnTheLmoFrame) {
   }
   std::filesystem::remove_all(dir);
   EXPECT_NE(evalReportTable(report).find("average"), std::string::npos);
+  // Every instance is in the top bin, so the table has no line of found by visibility.
+  EXPECT_EQ(evalReportTable(report).find("found by visibility"), std::string::npos);
 }
 
 }  // namespace

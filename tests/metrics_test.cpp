@@ -184,6 +184,40 @@ TEST_F(MetricsMatching, BarelyVisibleInstancesCanBeLeftOut) {
   EXPECT_EQ(found.counts.at(1).fn, 0);
 }
 
+TEST_F(MetricsMatching, InstancesAreCountedByHowVisibleTheyAre) {
+  // Four instances 0.05 m apart (no estimate is correct for two of them), 5 %, 30 %, 60 % and
+  // 100 % visible; the estimates find the 30 % and the 100 % one.
+  const std::vector<GroundTruthPose> gts = {gt(1, 0.f, 0.05f), gt(1, 0.05f, 0.3f), gt(1, 0.1f, 0.6f),
+                                            gt(1, 0.15f, 1.f)};
+  const auto r = evaluateImage({est(1, 0.05f, 0.9f), est(1, 0.15f, 0.8f), est(1, 0.3f, 0.7f)}, gts, models);
+  const VisibilityRecall& v = r.by_visibility.at(1);
+  EXPECT_EQ(v.instances, (std::array<int, 5>{1, 1, 0, 1, 1}));
+  EXPECT_EQ(v.found, (std::array<int, 5>{0, 1, 0, 0, 1}));
+  // The bins are 0.2 wide, each from its lower edge; 1 and above go to the top one.
+  EXPECT_EQ(VisibilityRecall::binOf(0.f), 0);
+  EXPECT_EQ(VisibilityRecall::binOf(0.1999f), 0);
+  EXPECT_EQ(VisibilityRecall::binOf(0.2f), 1);
+  EXPECT_EQ(VisibilityRecall::binOf(0.6f), 3);
+  EXPECT_EQ(VisibilityRecall::binOf(0.8f), 4);
+  EXPECT_EQ(VisibilityRecall::binOf(1.f), 4);
+  EXPECT_EQ(VisibilityRecall::binOf(1.5f), 4);
+  EXPECT_EQ(VisibilityRecall::binOf(-1.f), 0);
+  EXPECT_EQ(VisibilityRecall::binOf(std::nanf("")), 0);
+
+  // Instances left out of the scores (below min_visib_fract) are left out here as well.
+  EvalParams params;
+  params.min_visib_fract = 0.1f;
+  const auto left_out = evaluateImage({est(1, 0.f, 0.9f)}, gts, models, params);
+  EXPECT_EQ(left_out.by_visibility.at(1).instances, (std::array<int, 5>{0, 1, 0, 1, 1}));
+  EXPECT_EQ(left_out.by_visibility.at(1).found, (std::array<int, 5>{}));
+
+  // Summing images adds bin by bin.
+  VisibilityRecall sum = v;
+  sum += left_out.by_visibility.at(1);
+  EXPECT_EQ(sum.instances, (std::array<int, 5>{1, 2, 0, 2, 2}));
+  EXPECT_EQ(sum.found, (std::array<int, 5>{0, 1, 0, 0, 1}));
+}
+
 TEST_F(MetricsMatching, UnknownObjectsAndNonRotationsAreInputErrors) {
   EXPECT_NE(test::inputErrorOf([&] { evaluateImage({est(7, 0.f, 1.f)}, {}, models); }).find("object 7"), std::string::npos);
   EXPECT_NE(test::inputErrorOf([&] { evaluateImage({}, {gt(9, 0.f)}, models); }).find("object 9"), std::string::npos);

@@ -3,6 +3,7 @@
 // models), the paper's protocol (ADD/ADI under k_m * d, one-to-one matching, precision, recall,
 // F1), the BOP results CSV, writing BOP files (synth), and the full pipeline and the paper's two
 // baselines (LINEMOD alone, PPF) run side by side on the same images.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -190,6 +191,24 @@ struct EvalCounts {
   }
 };
 
+/// Instances found and annotated by how much of each is visible: where a method's misses are.
+/// Bins of visib_fract 0.2 wide ([0, 0.2), [0.2, 0.4), ..., [0.8, 1]); instances below
+/// EvalParams::min_visib_fract are left out, as from the counts.
+struct VisibilityRecall {
+  static constexpr int kBins = 5;
+  std::array<int, kBins> instances{};
+  std::array<int, kBins> found{};  ///< of those, matched by an estimate
+  /// The bin of a visib_fract (values outside 0..1 go to the nearest end).
+  static int binOf(float visib_fract);
+  VisibilityRecall& operator+=(const VisibilityRecall& o) {
+    for (int b = 0; b < kBins; ++b) {
+      instances[b] += o.instances[b];
+      found[b] += o.found[b];
+    }
+    return *this;
+  }
+};
+
 /// What became of one estimate.
 struct EstimateMatch {
   int gt = -1;           ///< index into the image's ground truth; -1: a false positive
@@ -200,6 +219,7 @@ struct EstimateMatch {
 struct ImageEvaluation {
   std::vector<EstimateMatch> matches;  ///< parallel to the estimates
   std::map<int, EvalCounts> counts;    ///< by obj_id, for every object estimated or annotated
+  std::map<int, VisibilityRecall> by_visibility;  ///< by obj_id, for every object annotated
 };
 
 /// Matches one image's estimates to its ground truth, object by object (see the top of this
@@ -401,6 +421,8 @@ struct MethodEvaluation {
   std::map<int, double> object_ms_per_image;
   std::vector<BopResult> results;  ///< every estimate, for the BOP CSV
   std::vector<ScoredOutcome> outcomes;  ///< every estimate's outcome, for precisionRecallCurve
+  /// Per object (every evaluated object): its instances found by how visible they are.
+  std::map<int, VisibilityRecall> by_visibility;
 };
 
 struct EvalReport {
@@ -429,8 +451,11 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
 /// The report as JSON:
 /// {"methods": {"vkpose": {"average": {"precision", "recall", "f1", "ms_per_image"},
 ///                         "objects": {"1": {"precision", "recall", "f1", "ms_per_image",
-///                                           "tp", "fp", "fn"}, ...}}, ...},
+///                                           "tp", "fp", "fn", "by_visibility"}, ...},
+///                         "by_visibility": [...]}, ...},
 ///  "dataset": ..., "split": ..., "images": N, "device": ...}
+/// by_visibility (per object, and for all objects together): a VisibilityRecall bin each,
+/// {"visib_fract": [from, to], "instances": n, "found": k}.
 std::string evalReportJson(const EvalReport& report);
 
 /// The precision-recall curves of a report as CSV: `method,obj_id,threshold,precision,recall,f1,
@@ -440,7 +465,9 @@ std::string precisionRecallCsv(const EvalReport& report);
 /// recall against the score threshold, with each method's figures at score 0.5.
 std::string precisionRecallSvg(const EvalReport& report);
 
-/// The side-by-side table: a row per object and method, then each method's average.
+/// The side-by-side table: a row per object and method, then each method's average, then,
+/// when not every instance is (almost) wholly visible, each method's instances found by
+/// visibility (all objects together).
 std::string evalReportTable(const EvalReport& report);
 
 /// Where the BOP results CSV of a method goes for `--out PATH`: METHOD_ before PATH's file

@@ -35,7 +35,21 @@ struct MethodRun {
   std::map<int, double> object_ms;
   std::vector<BopResult> results;
   std::vector<ScoredOutcome> outcomes;
+  std::map<int, VisibilityRecall> by_visibility;
 };
+
+/// The visibility bins of all objects together.
+VisibilityRecall allObjects(const std::map<int, VisibilityRecall>& by_object) {
+  VisibilityRecall sum;
+  for (const auto& [obj_id, v] : by_object) sum += v;
+  return sum;
+}
+
+/// "40-60 %" for bin 2.
+std::string visibilityBinName(int bin) {
+  constexpr int step = 100 / VisibilityRecall::kBins;
+  return fmt::format("{}-{} %", bin * step, (bin + 1) * step);
+}
 }  // namespace
 
 std::string methodName(EvalMethod method) {
@@ -153,6 +167,7 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
       try {
         const ImageEvaluation evaluation = evaluateImage(estimates, gt, models, params.eval);
         for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
+        for (const auto& [obj_id, v] : evaluation.by_visibility) run.by_visibility[obj_id] += v;
         for (std::size_t e = 0; e < estimates.size(); ++e)
           run.outcomes.push_back({estimates[e].obj_id, estimates[e].score, evaluation.matches[e].gt >= 0,
                                   evaluation.matches[e].ignored});
@@ -166,7 +181,10 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
   }
 
   for (MethodRun& run : runs) {
-    for (int obj_id : report.objects) run.counts[obj_id];  // objects never seen still count (as zeros)
+    for (int obj_id : report.objects) {  // objects never seen still count (as zeros)
+      run.counts[obj_id];
+      run.by_visibility[obj_id];
+    }
     MethodEvaluation m;
     m.method = run.method;
     m.summary = summarize(run.counts);
@@ -174,6 +192,7 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
     for (const auto& [obj_id, ms] : run.object_ms) m.object_ms_per_image[obj_id] = ms / static_cast<double>(n_images);
     m.results = std::move(run.results);
     m.outcomes = std::move(run.outcomes);
+    m.by_visibility = std::move(run.by_visibility);
     report.methods.push_back(std::move(m));
   }
   report.warnings.assign(warnings.begin(), warnings.end());
@@ -268,23 +287,37 @@ std::string precisionRecallSvg(const EvalReport& report) {
 
 std::string evalReportJson(const EvalReport& report) {
   using nlohmann::json;
+  const auto binsJson = [](const VisibilityRecall& v) {
+    json bins = json::array();
+    for (int b = 0; b < VisibilityRecall::kBins; ++b)
+      bins.push_back({{"visib_fract", {static_cast<double>(b) / VisibilityRecall::kBins,
+                                       static_cast<double>(b + 1) / VisibilityRecall::kBins}},
+                      {"instances", v.instances[static_cast<std::size_t>(b)]},
+                      {"found", v.found[static_cast<std::size_t>(b)]}});
+    return bins;
+  };
   json methods = json::object();
   for (const MethodEvaluation& m : report.methods) {
     json objects = json::object();
     for (const auto& [obj_id, s] : m.summary.objects) {
       const auto ms = m.object_ms_per_image.find(obj_id);
-      objects[std::to_string(obj_id)] = {{"precision", s.precision}, {"recall", s.recall},
-                                         {"f1", s.f1},
-                                         {"ms_per_image", ms == m.object_ms_per_image.end() ? 0.0 : ms->second},
-                                         {"tp", s.tp},
-                                         {"fp", s.fp},
-                                         {"fn", s.fn}};
+      const auto vis = m.by_visibility.find(obj_id);
+      objects[std::to_string(obj_id)] = {
+          {"precision", s.precision},
+          {"recall", s.recall},
+          {"f1", s.f1},
+          {"ms_per_image", ms == m.object_ms_per_image.end() ? 0.0 : ms->second},
+          {"tp", s.tp},
+          {"fp", s.fp},
+          {"fn", s.fn},
+          {"by_visibility", binsJson(vis == m.by_visibility.end() ? VisibilityRecall{} : vis->second)}};
     }
     methods[methodName(m.method)] = {
         {"average",
          {{"precision", m.summary.mean.precision}, {"recall", m.summary.mean.recall}, {"f1", m.summary.mean.f1},
           {"ms_per_image", m.ms_per_image}}},
-        {"objects", objects}};
+        {"objects", objects},
+        {"by_visibility", binsJson(allObjects(m.by_visibility))}};
   }
   const json doc = {{"methods", methods},
                     {"dataset", report.dataset},
@@ -307,6 +340,20 @@ std::string evalReportTable(const EvalReport& report) {
       row(std::to_string(obj_id), m, m.summary.objects.at(obj_id), ms == m.object_ms_per_image.end() ? 0.0 : ms->second);
     }
   for (const MethodEvaluation& m : report.methods) row("average", m, m.summary.mean, m.ms_per_image);
+  // Found by visibility, when the dataset says how visible its instances are (without
+  // scene_gt_info.json every instance is wholly visible and the line would say nothing new).
+  for (const MethodEvaluation& m : report.methods) {
+    const VisibilityRecall v = allObjects(m.by_visibility);
+    const int top = VisibilityRecall::kBins - 1;
+    int below_top = 0;
+    for (int b = 0; b < top; ++b) below_top += v.instances[static_cast<std::size_t>(b)];
+    if (below_top == 0) continue;
+    out += fmt::format("{} found by visibility:", methodName(m.method));
+    for (int b = 0; b < VisibilityRecall::kBins; ++b)
+      out += fmt::format("{} {}: {} of {}", b == 0 ? "" : ",", visibilityBinName(b), v.found[static_cast<std::size_t>(b)],
+                         v.instances[static_cast<std::size_t>(b)]);
+    out += "\n";
+  }
   return out;
 }
 

@@ -88,9 +88,20 @@ ImageEvaluation evaluateImage(const std::vector<PoseEstimate>& estimates, const 
   }
   for (std::size_t g = 0; g < gt.size(); ++g) {
     EvalCounts& c = result.counts[gt[g].obj_id];  // every annotated object gets an entry
-    if (!taken[g] && counted(g)) ++c.fn;
+    VisibilityRecall& v = result.by_visibility[gt[g].obj_id];
+    if (!counted(g)) continue;
+    if (!taken[g]) ++c.fn;
+    const int bin = VisibilityRecall::binOf(gt[g].visib_fract);
+    ++v.instances[bin];
+    if (taken[g]) ++v.found[bin];
   }
   return result;
+}
+
+int VisibilityRecall::binOf(float visib_fract) {
+  // NaN goes to the lowest bin; 1.0 (and above) to the top one.
+  const float v = std::isnan(visib_fract) ? 0.f : visib_fract;
+  return std::clamp(static_cast<int>(std::floor(v * kBins)), 0, kBins - 1);
 }
 
 ObjectScores scoresOf(const EvalCounts& c) {
