@@ -218,6 +218,36 @@ TEST_F(MetricsMatching, InstancesAreCountedByHowVisibleTheyAre) {
   EXPECT_EQ(sum.found, (std::array<int, 5>{0, 1, 0, 0, 1}));
 }
 
+TEST(Metrics, TheReportListsInstancesFoundByVisibility) {
+  EvalReport report;
+  report.objects = {1, 2};
+  MethodEvaluation m;
+  m.summary = summarize({{1, {2, 0, 1}}, {2, {1, 0, 0}}});
+  m.by_visibility[1].instances = {0, 0, 1, 0, 2};
+  m.by_visibility[1].found = {0, 0, 0, 0, 2};
+  m.by_visibility[2].instances = {0, 0, 0, 0, 1};
+  m.by_visibility[2].found = {0, 0, 0, 0, 1};
+  report.methods.push_back(m);
+  // All objects together, a bin each.
+  EXPECT_NE(evalReportTable(report).find("vkpose found by visibility: 0-20 %: 0 of 0, 20-40 %: 0 of 0, 40-60 %: 0 of 1, "
+                                         "60-80 %: 0 of 0, 80-100 %: 3 of 3\n"),
+            std::string::npos)
+      << evalReportTable(report);
+  const auto doc = nlohmann::json::parse(evalReportJson(report));
+  const auto& all = doc.at("methods").at("vkpose").at("by_visibility");
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_EQ(all.at(4).at("instances").get<int>(), 3);
+  EXPECT_EQ(all.at(4).at("found").get<int>(), 3);
+  EXPECT_EQ(all.at(2).at("instances").get<int>(), 1);
+  EXPECT_DOUBLE_EQ(all.at(2).at("visib_fract").at(1).get<double>(), 0.6);
+  EXPECT_EQ(doc.at("methods").at("vkpose").at("objects").at("1").at("by_visibility").at(2).at("instances").get<int>(), 1);
+  EXPECT_EQ(doc.at("methods").at("vkpose").at("objects").at("2").at("by_visibility").at(2).at("instances").get<int>(), 0);
+
+  // With every instance in the top bin the line would say nothing the table does not.
+  report.methods[0].by_visibility[1].instances = {0, 0, 0, 0, 3};
+  EXPECT_EQ(evalReportTable(report).find("found by visibility"), std::string::npos);
+}
+
 TEST_F(MetricsMatching, UnknownObjectsAndNonRotationsAreInputErrors) {
   EXPECT_NE(test::inputErrorOf([&] { evaluateImage({est(7, 0.f, 1.f)}, {}, models); }).find("object 7"), std::string::npos);
   EXPECT_NE(test::inputErrorOf([&] { evaluateImage({}, {gt(9, 0.f)}, models); }).find("object 9"), std::string::npos);
