@@ -15,7 +15,8 @@ layout(push_constant) uniform Push {
 } pc;
 
 const float kSubpixel = 8.0;      // fixed point: 1/8 pixel
-const float kNearZ = 1e-3;        // metres: triangles closer than this are dropped
+const float kNearZ = 1e-3;        // metres: a triangle with a corner this near or nearer is clipped
+const float kClipZ = 2e-3;        // metres: ... at this depth (clipFace), so no corner lies near zero
 const float kGuardPx = 1048576.0; // screen coordinates beyond this are dropped
 
 // Edge functions are exact integers. In 32 bits when the triangle spans less than
@@ -109,12 +110,119 @@ vec3 edgesAt(Triangle t, int x, int y) {
          t.sign;
 }
 
-// Depth where the pixel's ray meets the triangle's plane: exact, unaffected by the 1/8-pixel
-// snapping that decides coverage; clamped to the triangle's own depth range for grazing
-// triangles whose plane is nearly parallel to the ray.
-float depthAt(Triangle t, int x, int y) {
+// Depth where the pixel's ray meets the plane (n, n_p0): exact, unaffected by the 1/8-pixel
+// snapping that decides coverage; clamped to the face's own depth range for grazing faces
+// whose plane is nearly parallel to the ray.
+float planeDepthAt(vec3 n, float n_p0, vec2 zrange, int x, int y) {
   precise vec3 ray = vec3((float(x) - pc.cx) * (1.0 / pc.fx), (float(y) - pc.cy) * (1.0 / pc.fy), 1.0);
-  precise float denom = dot(t.n, ray);
-  precise float z = denom != 0.0 ? t.n_p0 * (1.0 / denom) : t.zrange.y;
-  return clamp(z, t.zrange.x, t.zrange.y);
+  precise float denom = dot(n, ray);
+  precise float z = denom != 0.0 ? n_p0 * (1.0 / denom) : zrange.y;
+  return clamp(z, zrange.x, zrange.y);
+}
+
+float depthAt(Triangle t, int x, int y) { return planeDepthAt(t.n, t.n_p0, t.zrange, x, y); }
+
+// A face with a corner at kNearZ or nearer (setupTriangle refuses it), cut by the plane
+// z = kClipZ: the part in front, a convex polygon of 3 or 4 corners in the face's winding.
+// Rare (a floor or a wall reaching past the camera), so kept apart from the triangle path.
+struct ClippedFace {
+  ivec2 s[4];    // screen, fixed point
+  int count;     // 3 or 4
+  bool wide;     // spans kNarrowExtent or more: edge functions in 64 bits
+  float sign;    // +1 or -1: the winding
+  ivec4 box;     // inclusive pixel bounds, clipped to the image
+  vec3 n;        // the face's plane normal (unnormalized), camera frame
+  float n_p0;
+  vec2 zrange;   // nearest and farthest corner depth of the polygon
+};
+
+// False when no corner lies at kNearZ or nearer (setupTriangle's case), when nothing is left
+// in front of kClipZ, or when a corner of what is left falls beyond the guard band.
+bool clipFace(uint view, uint f, out ClippedFace c) {
+  c.count = 0;
+  c.wide = false;
+  c.sign = 1.0;
+  c.box = ivec4(0, 0, -1, -1);
+  uvec4 idx = faces[f];
+  vec3 p[3] = vec3[3](toCamera(view, vertices[idx.x].xyz), toCamera(view, vertices[idx.y].xyz),
+                      toCamera(view, vertices[idx.z].xyz));
+  if (!(p[0].z <= kNearZ || p[1].z <= kNearZ || p[2].z <= kNearZ)) return false;
+  precise vec3 n = cross(p[1] - p[0], p[2] - p[0]);
+  precise float n_p0 = dot(n, p[0]);
+  c.n = n;
+  c.n_p0 = n_p0;
+  vec3 q[4];
+  int m = 0;
+  for (int i = 0; i < 3; ++i) {
+    vec3 a = p[i], b = p[i == 2 ? 0 : i + 1];
+    if (a.z > kClipZ) q[m++] = a;
+    if ((a.z > kClipZ) != (b.z > kClipZ)) {
+      precise float k = (kClipZ - a.z) / (b.z - a.z);
+      precise vec3 r = a + (b - a) * k;
+      q[m++] = vec3(r.xy, kClipZ);
+    }
+  }
+  if (m < 3) return false;
+  c.count = m;
+  c.zrange = vec2(kClipZ, kClipZ);
+  ivec2 lo = ivec2(2147483647), hi = ivec2(-2147483647);
+  for (int i = 0; i < m; ++i) {
+    precise float rz = 1.0 / q[i].z;
+    precise float sx = pc.fx * (q[i].x * rz) + pc.cx;
+    precise float sy = pc.fy * (q[i].y * rz) + pc.cy;
+    if (!(abs(sx) < kGuardPx && abs(sy) < kGuardPx)) return false;
+    c.s[i] = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
+    lo = min(lo, c.s[i]);
+    hi = max(hi, c.s[i]);
+    c.zrange.y = max(c.zrange.y, q[i].z);
+  }
+  c.wide = hi.x - lo.x >= kNarrowExtent || hi.y - lo.y >= kNarrowExtent;
+  // Twice the signed area (the shoelace sum, exact in 64 bits) gives the winding.
+  int64_t area = 0;
+  for (int i = 0; i < m; ++i) {
+    ivec2 a = c.s[i], b = c.s[i + 1 == m ? 0 : i + 1];
+    area += int64_t(a.x) * int64_t(b.y) - int64_t(b.x) * int64_t(a.y);
+  }
+  if (area == 0) return false;
+  c.sign = area > 0 ? 1.0 : -1.0;
+  c.box = ivec4(max(-floorDiv8(-lo.x), 0), max(-floorDiv8(-lo.y), 0), min(floorDiv8(hi.x), pc.width - 1),
+                min(floorDiv8(hi.y), pc.height - 1));
+  return c.box.x <= c.box.z && c.box.y <= c.box.w;
+}
+
+// Pixel (x, y) lies in the clipped face (edges included). No loop over the edges: lavapipe
+// counts every iteration of every loop against an invocation's 65,535 (rasterBands), and a
+// loop per pixel would cut a large face short.
+bool insideClipped(ClippedFace c, int x, int y) {
+  ivec2 p = ivec2(x * 8, y * 8);
+  ivec2 s3 = c.count == 4 ? c.s[3] : c.s[0];  // a triangle's third edge closes at s[0]
+  return edgeFunction(c.wide, c.s[0], c.s[1], p) * c.sign >= 0.0 &&
+         edgeFunction(c.wide, c.s[1], c.s[2], p) * c.sign >= 0.0 &&
+         edgeFunction(c.wide, c.s[2], s3, p) * c.sign >= 0.0 &&
+         (c.count == 3 || edgeFunction(c.wide, s3, c.s[0], p) * c.sign >= 0.0);
+}
+
+// The rows of `box` that this invocation rasterizes: the box's rows are shared among the
+// dispatch's z groups, one band each, because lavapipe ends an invocation's loops after
+// 65,535 iterations in all, which cut off the lower rows of a face whose box held more
+// pixels (src/render/renderer.cpp, rasterBands).
+ivec2 bandRows(ivec4 box) {
+  const int bands = int(gl_NumWorkGroups.z), rows = (box.w - box.y + bands) / bands;
+  const int y0 = box.y + int(gl_WorkGroupID.z) * rows;
+  return ivec2(y0, min(box.w, y0 + rows - 1));
+}
+
+// Perspective-correct weights of the face's corners at the camera point `point` on its plane,
+// from the corners' camera points: for clipped faces, whose own screen corners are not the
+// face's.
+vec3 faceWeights(uint view, uint f, vec3 point, out vec3 n_out) {
+  uvec4 idx = faces[f];
+  vec3 p0 = toCamera(view, vertices[idx.x].xyz), p1 = toCamera(view, vertices[idx.y].xyz),
+       p2 = toCamera(view, vertices[idx.z].xyz);
+  precise vec3 n = cross(p1 - p0, p2 - p0);
+  precise float inv = 1.0 / dot(n, n);
+  precise float w0 = dot(cross(p1 - point, p2 - point), n) * inv;
+  precise float w1 = dot(cross(p2 - point, p0 - point), n) * inv;
+  n_out = n;
+  return vec3(w0, w1, 1.0 - w0 - w1);
 }

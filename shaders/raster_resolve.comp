@@ -27,13 +27,21 @@ void main() {
     return;
   }
   uint f = uint(key & 0xFFFFFFFFul);
-  Triangle t;
-  setupTriangle(view, f, t);
   int y = int(i) / pc.width, x = int(i) - y * pc.width;
-  vec3 e = edgesAt(t, x, y);
   precise float z = uintBitsToFloat(uint(key >> 32));
-  precise float inv_area = 1.0 / t.area;
-  precise vec3 w = vec3(e.x * inv_area * t.rz.x * z, e.y * inv_area * t.rz.y * z, e.z * inv_area * t.rz.z * z);
+  Triangle t;
+  precise vec3 w;
+  vec3 face_n;
+  if (setupTriangle(view, f, t)) {
+    vec3 e = edgesAt(t, x, y);
+    precise float inv_area = 1.0 / t.area;
+    w = vec3(e.x * inv_area * t.rz.x * z, e.y * inv_area * t.rz.y * z, e.z * inv_area * t.rz.z * z);
+    face_n = t.n;
+  } else {
+    // A clipped face (raster_depth.comp): weights from its corners in the camera frame.
+    precise vec3 point = vec3((float(x) - pc.cx) * (1.0 / pc.fx), (float(y) - pc.cy) * (1.0 / pc.fy), 1.0) * z;
+    w = faceWeights(view, f, point, face_n);
+  }
   uvec4 idx = faces[f];
   precise vec3 n;
   if ((pc.flags & 1u) != 0u) {
@@ -41,7 +49,7 @@ void main() {
     vec4 r0 = poses[3u * view], r1 = poses[3u * view + 1u], r2 = poses[3u * view + 2u];
     n = vec3(dot(r0.xyz, m), dot(r1.xyz, m), dot(r2.xyz, m));
   } else {
-    n = t.n;
+    n = face_n;
   }
   precise vec3 ray = vec3((float(x) - pc.cx) / pc.fx, (float(y) - pc.cy) / pc.fy, 1.0);
   precise float len2 = dot(n, n);

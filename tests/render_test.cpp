@@ -161,6 +161,55 @@ TEST(Render, TrianglesOfMoreThanLavapipesLoopLimitInPixelsRenderWhole) {
   EXPECT_GE(g.min_normal_dot, 0.999f);
 }
 
+// A floor under the camera that reaches behind it: each of its two triangles has a corner
+// behind the camera, which the rasterizer once dropped (synth tiled its floors and bin walls
+// for that). Now the part in front of the near plane is drawn: every pixel whose ray meets the
+// floor within its extent, at the depth where it meets it, on the GPU as in the reference,
+// with the corners' colours interpolated alike.
+TEST(Render, AFloorReachingBehindTheCameraIsClippedNotDropped) {
+  Mesh floor;
+  floor.name = "floor";
+  constexpr float kBelow = 0.1f, kHalfWidth = 0.8f, kBehind = -0.5f, kAhead = 3.f;  // camera frame, metres
+  floor.vertices = {{-kHalfWidth, kBelow, kBehind}, {kHalfWidth, kBelow, kBehind}, {kHalfWidth, kBelow, kAhead},
+                    {-kHalfWidth, kBelow, kAhead}};
+  floor.colours = {{1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, 0.f, 1.f}, {1.f, 1.f, 1.f}};
+  floor.faces = {{0, 1, 2}, {0, 2, 3}};
+  finishMesh(floor);
+  // A whole frame: the floor's box spans all of its width and its lower half, more pixels than
+  // lavapipe lets one invocation visit (rasterBands shares them out).
+  const Camera cam;
+  ASSERT_EQ(cam.width * cam.height, 640 * 480);
+  const Pose pose;  // the mesh is in the camera frame
+  MeshRenderer renderer(test::context(), floor);
+  const Rendering gpu = renderer.render(cam, {pose})[0];
+  const Rendering ref = renderReference(floor, cam, pose);
+  int expected = 0, covered = 0, depth_right = 0;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const float ry = static_cast<float>((y - cam.cy) / cam.fy), rx = static_cast<float>((x - cam.cx) / cam.fx);
+      const float z = ry > 0.f ? kBelow / ry : 0.f;  // where the ray meets the floor's plane
+      // Pixels a pixel or more inside the floor's outline (its far edge and its sides).
+      const bool inside = ry > 0.f && z < kAhead * 0.98f && std::abs(rx * z) < kHalfWidth * 0.98f;
+      if (!inside) continue;
+      ++expected;
+      const float got = gpu.depth.at<float>(y, x);
+      covered += got > 0.f;
+      depth_right += std::abs(got - z) <= 1e-4f * z;
+    }
+  ASSERT_GT(expected, 100000);
+  EXPECT_EQ(covered, expected);
+  EXPECT_GE(depth_right, expected * 999 / 1000);
+  const Agreement g = compare(gpu, ref);
+  EXPECT_GE(g.mask_agree, 0.9995);
+  EXPECT_LE(g.max_depth_rel, 1e-5f);
+  EXPECT_GE(g.min_normal_dot, 0.999f);
+  EXPECT_LE(g.max_colour, 2);
+  // The colours vary along the floor: the corners' weights were used.
+  const cv::Vec3b near = gpu.bgr.at<cv::Vec3b>(cam.height - 1, cam.width / 2);
+  const cv::Vec3b far = gpu.bgr.at<cv::Vec3b>(static_cast<int>(cam.cy) + 4, cam.width / 2);
+  EXPECT_GT(cv::norm(cv::Vec3i(near) - cv::Vec3i(far)), 30.0);
+}
+
 /// Distance along the pixel's ray (z) to an axis-aligned box under `pose`, or 0 for a miss.
 float rayCastBox(const Camera& cam, const Pose& pose, const Eigen::Vector3f& half, int x, int y) {
   const Eigen::Vector3f ray_cam((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0);

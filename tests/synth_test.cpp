@@ -269,8 +269,9 @@ TEST(SynthScene, AnObjectTheBorderCutsInHalfIsHalfVisible) {
 
 TEST(SynthScene, ABinFloorSeenFromCloseIsWhole) {
   // A 1 m floor tilted 60 degrees, its centre 0.3 m in front of the camera: its near half
-  // reaches behind the camera, whose triangles the rasterizer drops. Tiled, every pixel whose
-  // ray meets the floor's top face (1 cm from its edges) shows the floor.
+  // reaches behind the camera (whose triangles the rasterizer once dropped, and now clips).
+  // Tiled, every pixel whose ray meets the floor's top face (1 cm from its edges) shows the
+  // floor.
   const float side = 1.f, thickness = 0.01f;
   const Mesh floor = cuboidMesh({side, side, thickness}, {0.4f, 0.3f, 0.3f}, 0.05f);
   SceneObject o;

@@ -12,7 +12,8 @@
 namespace vkpose::render {
 
 constexpr float kSubpixel = 8.0f;
-constexpr float kNearZ = 1e-3f;
+constexpr float kNearZ = 1e-3f;  ///< a triangle with a corner this near or nearer is clipped
+constexpr float kClipZ = 2e-3f;  ///< ... at this depth (clipFace)
 constexpr float kGuardPx = 1048576.0f;
 
 struct Fixed2 {
@@ -52,6 +53,14 @@ inline int64_t edgeFunction(Fixed2 a, Fixed2 b, Fixed2 p) {
   return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
 }
 
+/// cross() and dot() spelled out in the shader's order of operations.
+inline Eigen::Vector3f crossAsShader(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return {a.y() * b.z() - b.y() * a.z(), a.z() * b.x() - b.z() * a.x(), a.x() * b.y() - b.x() * a.y()};
+}
+inline float dotAsShader(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return a.x() * b.x() + a.y() * b.y() + a.z() * b.z();
+}
+
 inline bool setupTriangle(const ScreenParams& sp, const Pose& pose, const std::array<Eigen::Vector3f, 3>& v,
                           Triangle& t) {
   for (int i = 0; i < 3; ++i) {
@@ -66,10 +75,8 @@ inline bool setupTriangle(const ScreenParams& sp, const Pose& pose, const std::a
   }
   const int64_t area = edgeFunction(t.s[0], t.s[1], t.s[2]);
   if (area == 0) return false;
-  const Eigen::Vector3f e1 = t.p[1] - t.p[0], e2 = t.p[2] - t.p[0];
-  // cross() and dot() spelled out in the shader's order of operations.
-  t.n = {e1.y() * e2.z() - e2.y() * e1.z(), e1.z() * e2.x() - e2.z() * e1.x(), e1.x() * e2.y() - e2.x() * e1.y()};
-  t.n_p0 = t.n.x() * t.p[0].x() + t.n.y() * t.p[0].y() + t.n.z() * t.p[0].z();
+  t.n = crossAsShader(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+  t.n_p0 = dotAsShader(t.n, t.p[0]);
   t.z_near = std::min({t.p[0].z(), t.p[1].z(), t.p[2].z()});
   t.z_far = std::max({t.p[0].z(), t.p[1].z(), t.p[2].z()});
   t.sign = area > 0 ? 1 : -1;
@@ -89,11 +96,95 @@ inline std::array<int64_t, 3> edgesAt(const Triangle& t, int x, int y) {
           edgeFunction(t.s[0], t.s[1], p) * t.sign};
 }
 
-inline float depthAt(const ScreenParams& sp, const Triangle& t, int x, int y) {
+inline float planeDepthAt(const ScreenParams& sp, const Eigen::Vector3f& n, float n_p0, float z_near, float z_far,
+                          int x, int y) {
   const float rx = (static_cast<float>(x) - sp.cx) * (1.0f / sp.fx), ry = (static_cast<float>(y) - sp.cy) * (1.0f / sp.fy);
-  const float denom = t.n.x() * rx + t.n.y() * ry + t.n.z() * 1.0f;
-  const float z = denom != 0.0f ? t.n_p0 * (1.0f / denom) : t.z_far;
-  return std::clamp(z, t.z_near, t.z_far);
+  const float denom = n.x() * rx + n.y() * ry + n.z() * 1.0f;
+  const float z = denom != 0.0f ? n_p0 * (1.0f / denom) : z_far;
+  return std::clamp(z, z_near, z_far);
+}
+
+inline float depthAt(const ScreenParams& sp, const Triangle& t, int x, int y) {
+  return planeDepthAt(sp, t.n, t.n_p0, t.z_near, t.z_far, x, y);
+}
+
+/// The shader's ClippedFace: a face with a corner at kNearZ or nearer, cut at kClipZ.
+struct ClippedFace {
+  std::array<Fixed2, 4> s;
+  int count = 0;
+  int64_t sign = 1;
+  int box_x0 = 0, box_y0 = 0, box_x1 = -1, box_y1 = -1;
+  Eigen::Vector3f n = Eigen::Vector3f::Zero();
+  float n_p0 = 0.f;
+  float z_near = kClipZ, z_far = kClipZ;
+};
+
+/// False when no corner lies at kNearZ or nearer (setupTriangle's case), when nothing is left
+/// in front of kClipZ, or when a corner of what is left falls beyond the guard band.
+inline bool clipFace(const ScreenParams& sp, const Pose& pose, const std::array<Eigen::Vector3f, 3>& v,
+                     ClippedFace& c) {
+  std::array<Eigen::Vector3f, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = toCamera(pose, v[i]);
+  if (!(p[0].z() <= kNearZ || p[1].z() <= kNearZ || p[2].z() <= kNearZ)) return false;
+  c.n = crossAsShader(p[1] - p[0], p[2] - p[0]);
+  c.n_p0 = dotAsShader(c.n, p[0]);
+  std::array<Eigen::Vector3f, 4> q;
+  int m = 0;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3f& a = p[i];
+    const Eigen::Vector3f& b = p[i == 2 ? 0 : i + 1];
+    if (a.z() > kClipZ) q[m++] = a;
+    if ((a.z() > kClipZ) != (b.z() > kClipZ)) {
+      const float k = (kClipZ - a.z()) / (b.z() - a.z());
+      const Eigen::Vector3f r = a + (b - a) * k;
+      q[m++] = {r.x(), r.y(), kClipZ};
+    }
+  }
+  if (m < 3) return false;
+  c.count = m;
+  c.z_near = c.z_far = kClipZ;
+  int64_t x0 = INT64_MAX, y0 = INT64_MAX, x1 = INT64_MIN, y1 = INT64_MIN;
+  for (int i = 0; i < m; ++i) {
+    const float rz = 1.0f / q[i].z();
+    const float sx = sp.fx * (q[i].x() * rz) + sp.cx;
+    const float sy = sp.fy * (q[i].y() * rz) + sp.cy;
+    if (!(std::abs(sx) < kGuardPx && std::abs(sy) < kGuardPx)) return false;
+    c.s[i] = {static_cast<int64_t>(std::floor(sx * kSubpixel + 0.5f)), static_cast<int64_t>(std::floor(sy * kSubpixel + 0.5f))};
+    x0 = std::min(x0, c.s[i].x), x1 = std::max(x1, c.s[i].x);
+    y0 = std::min(y0, c.s[i].y), y1 = std::max(y1, c.s[i].y);
+    c.z_far = std::max(c.z_far, q[i].z());
+  }
+  int64_t area = 0;  // twice the signed area: the winding
+  for (int i = 0; i < m; ++i) {
+    const Fixed2 a = c.s[i], b = c.s[i + 1 == m ? 0 : i + 1];
+    area += a.x * b.y - b.x * a.y;
+  }
+  if (area == 0) return false;
+  c.sign = area > 0 ? 1 : -1;
+  c.box_x0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-x0), 0));
+  c.box_y0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-y0), 0));
+  c.box_x1 = static_cast<int>(std::min<int64_t>(floorDiv8(x1), sp.width - 1));
+  c.box_y1 = static_cast<int>(std::min<int64_t>(floorDiv8(y1), sp.height - 1));
+  return c.box_x0 <= c.box_x1 && c.box_y0 <= c.box_y1;
+}
+
+inline bool insideClipped(const ClippedFace& c, int x, int y) {
+  const Fixed2 p{int64_t{x} * 8, int64_t{y} * 8};
+  for (int i = 0; i < c.count; ++i)
+    if (edgeFunction(c.s[i], c.s[i + 1 == c.count ? 0 : i + 1], p) * c.sign < 0) return false;
+  return true;
+}
+
+/// Perspective-correct weights of the face's corners at the camera point `point` on its
+/// plane, and the face's normal (unnormalized): for clipped faces.
+inline Eigen::Vector3f faceWeights(const Pose& pose, const std::array<Eigen::Vector3f, 3>& v,
+                                   const Eigen::Vector3f& point, Eigen::Vector3f& n) {
+  const Eigen::Vector3f p0 = toCamera(pose, v[0]), p1 = toCamera(pose, v[1]), p2 = toCamera(pose, v[2]);
+  n = crossAsShader(p1 - p0, p2 - p0);
+  const float inv = 1.0f / dotAsShader(n, n);
+  const float w0 = dotAsShader(crossAsShader(p1 - point, p2 - point), n) * inv;
+  const float w1 = dotAsShader(crossAsShader(p2 - point, p0 - point), n) * inv;
+  return {w0, w1, 1.0f - w0 - w1};
 }
 
 inline uint32_t packChannel(float c) { return static_cast<uint32_t>(std::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f); }

@@ -46,19 +46,29 @@ Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& po
   auto corners = [&](const Eigen::Vector3i& f) {
     return std::array<Eigen::Vector3f, 3>{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
   };
+  const auto write = [&](int x, int y, float z, std::size_t f) {
+    uint32_t bits;
+    std::memcpy(&bits, &z, 4);
+    auto& slot = raster[static_cast<std::size_t>(y) * W + x];
+    slot = std::min(slot, (uint64_t{bits} << 32) | f);
+  };
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     Triangle t;
-    if (!render::setupTriangle(sp, pose, corners(mesh.faces[f]), t)) continue;
-    for (int y = t.box_y0; y <= t.box_y1; ++y)
-      for (int x = t.box_x0; x <= t.box_x1; ++x) {
-        const auto e = render::edgesAt(t, x, y);
-        if (e[0] < 0 || e[1] < 0 || e[2] < 0) continue;
-        const float z = render::depthAt(sp, t, x, y);
-        uint32_t bits;
-        std::memcpy(&bits, &z, 4);
-        auto& slot = raster[static_cast<std::size_t>(y) * W + x];
-        slot = std::min(slot, (uint64_t{bits} << 32) | f);
-      }
+    if (render::setupTriangle(sp, pose, corners(mesh.faces[f]), t)) {
+      for (int y = t.box_y0; y <= t.box_y1; ++y)
+        for (int x = t.box_x0; x <= t.box_x1; ++x) {
+          const auto e = render::edgesAt(t, x, y);
+          if (e[0] < 0 || e[1] < 0 || e[2] < 0) continue;
+          write(x, y, render::depthAt(sp, t, x, y), f);
+        }
+      continue;
+    }
+    // A face reaching past the camera: its part in front of kClipZ.
+    render::ClippedFace c;
+    if (!render::clipFace(sp, pose, corners(mesh.faces[f]), c)) continue;
+    for (int y = c.box_y0; y <= c.box_y1; ++y)
+      for (int x = c.box_x0; x <= c.box_x1; ++x)
+        if (render::insideClipped(c, x, y)) write(x, y, render::planeDepthAt(sp, c.n, c.n_p0, c.z_near, c.z_far, x, y), f);
   }
   Rendering out;
   out.depth = cv::Mat::zeros(H, W, CV_32FC1);
@@ -73,22 +83,28 @@ Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& po
       if (key == std::numeric_limits<uint64_t>::max()) continue;
       const auto f = static_cast<uint32_t>(key & 0xFFFFFFFFu);
       const Eigen::Vector3i& idx = mesh.faces[f];
-      Triangle t;
-      render::setupTriangle(sp, pose, corners(idx), t);
-      const auto e = render::edgesAt(t, x, y);
       float z;
       const auto zbits = static_cast<uint32_t>(key >> 32);
       std::memcpy(&z, &zbits, 4);
-      const float inv_area = 1.0f / static_cast<float>(t.area);
-      const Eigen::Vector3f w(static_cast<float>(e[0]) * inv_area * t.rz[0] * z,
-                              static_cast<float>(e[1]) * inv_area * t.rz[1] * z,
-                              static_cast<float>(e[2]) * inv_area * t.rz[2] * z);
+      Triangle t;
+      Eigen::Vector3f w, face_n;
+      if (render::setupTriangle(sp, pose, corners(idx), t)) {
+        const auto e = render::edgesAt(t, x, y);
+        const float inv_area = 1.0f / static_cast<float>(t.area);
+        w = {static_cast<float>(e[0]) * inv_area * t.rz[0] * z, static_cast<float>(e[1]) * inv_area * t.rz[1] * z,
+             static_cast<float>(e[2]) * inv_area * t.rz[2] * z};
+        face_n = t.n;
+      } else {  // a clipped face: weights from its corners in the camera frame
+        const Eigen::Vector3f point((static_cast<float>(x) - sp.cx) * (1.0f / sp.fx),
+                                    (static_cast<float>(y) - sp.cy) * (1.0f / sp.fy), 1.0f);
+        w = render::faceWeights(pose, corners(idx), point * z, face_n);
+      }
       Eigen::Vector3f n;
       if (has_normals) {
         const Eigen::Vector3f m = w.x() * mesh.normals[idx[0]] + w.y() * mesh.normals[idx[1]] + w.z() * mesh.normals[idx[2]];
         n = render::toCamera({pose.R, Eigen::Vector3f::Zero()}, m);
       } else {
-        n = t.n;
+        n = face_n;
       }
       const Eigen::Vector3f ray((static_cast<float>(x) - sp.cx) / sp.fx, (static_cast<float>(y) - sp.cy) / sp.fy, 1.0f);
       const float len2 = n.dot(n);
@@ -168,8 +184,11 @@ struct MeshRenderer::Impl {
         workspace(ws ? std::move(ws) : makeRenderWorkspace(c)),
         batch(workspace->batch),
         raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush)),
+        clipped(c, gpu::ShaderId::raster_clipped, 4, sizeof(RasterPush)),
         resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush)) {
     face_count = static_cast<uint32_t>(mesh.faces.size());
+    centre = mesh.bboxCentre();
+    for (const auto& v : mesh.vertices) radius = std::max(radius, (v - centre).norm());
     flags = (mesh.normals.empty() ? 0u : 1u) | (mesh.colours.empty() ? 0u : 2u);
     std::vector<float> v4;
     for (const auto& v : mesh.vertices) v4.insert(v4.end(), {v.x(), v.y(), v.z(), 0.f});
@@ -198,9 +217,18 @@ struct MeshRenderer::Impl {
   const GpuContext& ctx;
   std::shared_ptr<RenderWorkspace> workspace;
   gpu::Batch& batch;
-  gpu::Kernel raster, resolve;
+  gpu::Kernel raster, clipped, resolve;
   gpu::Buffer vertices, faces, normals, colours;
   uint32_t face_count = 0, flags = 0;
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  ///< of the mesh's box, object frame
+  float radius = 0.f;                                ///< every vertex lies within it of centre
+
+  /// Some pose puts a vertex at render::kNearZ or nearer: the batch needs the clipping pass.
+  bool reachesPastTheCamera(const std::vector<Pose>& poses, std::size_t first, std::size_t n) const {
+    for (std::size_t v = first; v < first + n; ++v)
+      if ((poses[v].R * centre + poses[v].t).z() - radius <= render::kNearZ) return true;
+    return false;
+  }
 };
 
 MeshRenderer::MeshRenderer(const GpuContext& ctx, const Mesh& mesh, std::shared_ptr<RenderWorkspace> workspace) {
@@ -254,6 +282,9 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
     batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
                    static_cast<uint32_t>(n), rasterBands(camera));
+    if (m.reachesPastTheCamera(poses, first, n))
+      batch.dispatch(m.clipped, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
+                     static_cast<uint32_t>(n), rasterBands(camera));
     batch.dispatch(m.resolve,
                    {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
                    push, gpu::groupsFor(pixels, 64), static_cast<uint32_t>(n));

@@ -97,8 +97,9 @@ SceneRendering renderScene(const GpuContext& ctx, const std::vector<SceneObject>
 
 Mesh planeMesh(float size, float grey) {
   if (!(size > 0.f) || size > 100.f) throw InputError("plane size must be in (0, 100] metres");
-  // Tiles of at most 5 cm: the rasterizer drops a triangle with a corner far outside the
-  // image instead of clipping it, so a large plane must be made of small pieces.
+  // Tiles of at most 5 cm: the rasterizer clips a triangle at the camera's near plane, but
+  // drops one with a corner far outside the image (beyond its guard band of about a million
+  // pixels), so a large plane must be made of small pieces.
   const int n = std::max(1, static_cast<int>(std::ceil(size / 0.05f)));
   Mesh m;
   m.name = "plane";

@@ -41,8 +41,9 @@ Mesh planeMesh(float size, float grey = 0.55f);
 
 /// A box of side lengths `size` (metres) centred at the origin, flat-shaded (its own vertices
 /// per face), of one colour (RGB 0..1): clutter, bin walls. With `max_tile_m` > 0 each face is
-/// made of tiles no larger than that, as planeMesh's are: the rasterizer drops a triangle with
-/// a corner behind the camera, and a bin seen from close by can reach behind it.
+/// made of tiles no larger than that, as planeMesh's are: the rasterizer once dropped a
+/// triangle with a corner behind the camera (a bin seen from close by reaches behind it); it
+/// clips them now, and the tiles stay so that synth's datasets keep their bytes.
 Mesh cuboidMesh(const Eigen::Vector3f& size, const Eigen::Vector3f& rgb, float max_tile_m = 0.f);
 
 /// A closed cylinder along z centred at the origin, `segments` sides: cans and jars as clutter.
