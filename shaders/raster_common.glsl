@@ -54,16 +54,30 @@ float edgeFunction(bool wide, ivec2 a, ivec2 b, ivec2 p) {
   return float((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x));
 }
 
-// One corner: camera point, 1 / z and the fixed-point screen position; false when it lies
-// nearer than kNearZ or beyond the guard band (then the other outputs mean nothing).
-bool projectCorner(uint view, uint vertex, out vec3 p, out float rz_out, out ivec2 s) {
-  p = toCamera(view, vertices[vertex].xyz);
+// A camera point's 1 / z and fixed-point screen position; false beyond the guard band (then
+// the outputs mean nothing). Triangles and clipped faces round their corners alike.
+bool projectPoint(vec3 p, out float rz_out, out ivec2 s) {
   precise float rz = 1.0 / p.z;
   precise float sx = pc.fx * (p.x * rz) + pc.cx;
   precise float sy = pc.fy * (p.y * rz) + pc.cy;
   rz_out = rz;
   s = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
-  return p.z > kNearZ && abs(sx) < kGuardPx && abs(sy) < kGuardPx;
+  return abs(sx) < kGuardPx && abs(sy) < kGuardPx;
+}
+
+// One corner: camera point, 1 / z and the fixed-point screen position; false when it lies
+// nearer than kNearZ or beyond the guard band (then the other outputs mean nothing).
+bool projectCorner(uint view, uint vertex, out vec3 p, out float rz_out, out ivec2 s) {
+  p = toCamera(view, vertices[vertex].xyz);
+  const bool on_screen = projectPoint(p, rz_out, s);
+  return p.z > kNearZ && on_screen;
+}
+
+// Inclusive pixel bounds of fixed-point corners from lo to hi, clipped to the image. Pixel
+// centres sit on integer coordinates (OpenCV's convention): lo / 8 rounded up.
+ivec4 pixelBox(ivec2 lo, ivec2 hi) {
+  return ivec4(max(-floorDiv8(-lo.x), 0), max(-floorDiv8(-lo.y), 0), min(floorDiv8(hi.x), pc.width - 1),
+               min(floorDiv8(hi.y), pc.height - 1));
 }
 
 bool setupTriangle(uint view, uint f, out Triangle t) {
@@ -95,9 +109,7 @@ bool setupTriangle(uint view, uint f, out Triangle t) {
   t.zrange = vec2(min(p0.z, min(p1.z, p2.z)), max(p0.z, max(p1.z, p2.z)));
   t.sign = area > 0.0 ? 1.0 : -1.0;
   t.area = area * t.sign;
-  // Pixel centres sit on integer coordinates (OpenCV's convention): lo / 8 rounded up.
-  t.box = ivec4(max(-floorDiv8(-lo.x), 0), max(-floorDiv8(-lo.y), 0), min(floorDiv8(hi.x), pc.width - 1),
-                min(floorDiv8(hi.y), pc.height - 1));
+  t.box = pixelBox(lo, hi);
   return t.box.x <= t.box.z && t.box.y <= t.box.w;
 }
 
@@ -167,11 +179,8 @@ bool clipFace(uint view, uint f, out ClippedFace c) {
   c.zrange = vec2(kClipZ, kClipZ);
   ivec2 lo = ivec2(2147483647), hi = ivec2(-2147483647);
   for (int i = 0; i < m; ++i) {
-    precise float rz = 1.0 / q[i].z;
-    precise float sx = pc.fx * (q[i].x * rz) + pc.cx;
-    precise float sy = pc.fy * (q[i].y * rz) + pc.cy;
-    if (!(abs(sx) < kGuardPx && abs(sy) < kGuardPx)) return false;
-    c.s[i] = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
+    float rz;
+    if (!projectPoint(q[i], rz, c.s[i])) return false;
     lo = min(lo, c.s[i]);
     hi = max(hi, c.s[i]);
     c.zrange.y = max(c.zrange.y, q[i].z);
@@ -185,8 +194,7 @@ bool clipFace(uint view, uint f, out ClippedFace c) {
   }
   if (area == 0) return false;
   c.sign = area > 0 ? 1.0 : -1.0;
-  c.box = ivec4(max(-floorDiv8(-lo.x), 0), max(-floorDiv8(-lo.y), 0), min(floorDiv8(hi.x), pc.width - 1),
-                min(floorDiv8(hi.y), pc.height - 1));
+  c.box = pixelBox(lo, hi);
   return c.box.x <= c.box.z && c.box.y <= c.box.w;
 }
 

@@ -13,12 +13,8 @@ void main() {
   Triangle t;
   if (!setupTriangle(view, f, t)) return;
   uint base = view * uint(pc.width * pc.height);
-  // The box's rows are shared among the dispatch's z groups, each invocation taking one band:
-  // lavapipe ends an invocation's loops after 65,535 iterations in all, which cut off the
-  // lower rows of a triangle whose box held more pixels (src/render/renderer.cpp, rasterBands).
-  const int bands = int(gl_NumWorkGroups.z), rows = (t.box.w - t.box.y + bands) / bands;
-  const int y0 = t.box.y + int(gl_WorkGroupID.z) * rows, y1 = min(t.box.w, y0 + rows - 1);
-  for (int y = y0; y <= y1; ++y)
+  const ivec2 rows = bandRows(t.box);  // this invocation's share of the box's rows
+  for (int y = rows.x; y <= rows.y; ++y)
     for (int x = t.box.x; x <= t.box.z; ++x) {
       vec3 e = edgesAt(t, x, y);
       if (e.x < 0.0 || e.y < 0.0 || e.z < 0.0) continue;

@@ -61,17 +61,33 @@ inline float dotAsShader(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
   return a.x() * b.x() + a.y() * b.y() + a.z() * b.z();
 }
 
+/// The shader's projectPoint: a camera point's 1 / z and fixed-point screen position; false
+/// beyond the guard band.
+inline bool projectPoint(const ScreenParams& sp, const Eigen::Vector3f& p, float& rz, Fixed2& s) {
+  rz = 1.0f / p.z();
+  const float sx = sp.fx * (p.x() * rz) + sp.cx;
+  const float sy = sp.fy * (p.y() * rz) + sp.cy;
+  s = {static_cast<int64_t>(std::floor(sx * kSubpixel + 0.5f)), static_cast<int64_t>(std::floor(sy * kSubpixel + 0.5f))};
+  return std::abs(sx) < kGuardPx && std::abs(sy) < kGuardPx;
+}
+
+/// The shader's pixelBox: inclusive pixel bounds of fixed-point corners from (x0, y0) to
+/// (x1, y1), clipped to the image; false when nothing is left.
+inline bool pixelBox(const ScreenParams& sp, int64_t x0, int64_t y0, int64_t x1, int64_t y1, int& box_x0,
+                     int& box_y0, int& box_x1, int& box_y1) {
+  box_x0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-x0), 0));
+  box_y0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-y0), 0));
+  box_x1 = static_cast<int>(std::min<int64_t>(floorDiv8(x1), sp.width - 1));
+  box_y1 = static_cast<int>(std::min<int64_t>(floorDiv8(y1), sp.height - 1));
+  return box_x0 <= box_x1 && box_y0 <= box_y1;
+}
+
 inline bool setupTriangle(const ScreenParams& sp, const Pose& pose, const std::array<Eigen::Vector3f, 3>& v,
                           Triangle& t) {
   for (int i = 0; i < 3; ++i) {
     t.p[i] = toCamera(pose, v[i]);
     if (!(t.p[i].z() > kNearZ)) return false;
-    const float rz = 1.0f / t.p[i].z();
-    const float sx = sp.fx * (t.p[i].x() * rz) + sp.cx;
-    const float sy = sp.fy * (t.p[i].y() * rz) + sp.cy;
-    if (!(std::abs(sx) < kGuardPx && std::abs(sy) < kGuardPx)) return false;
-    t.rz[i] = rz;
-    t.s[i] = {static_cast<int64_t>(std::floor(sx * kSubpixel + 0.5f)), static_cast<int64_t>(std::floor(sy * kSubpixel + 0.5f))};
+    if (!projectPoint(sp, t.p[i], t.rz[i], t.s[i])) return false;
   }
   const int64_t area = edgeFunction(t.s[0], t.s[1], t.s[2]);
   if (area == 0) return false;
@@ -83,11 +99,7 @@ inline bool setupTriangle(const ScreenParams& sp, const Pose& pose, const std::a
   t.area = area * t.sign;
   const int64_t x0 = std::min({t.s[0].x, t.s[1].x, t.s[2].x}), x1 = std::max({t.s[0].x, t.s[1].x, t.s[2].x});
   const int64_t y0 = std::min({t.s[0].y, t.s[1].y, t.s[2].y}), y1 = std::max({t.s[0].y, t.s[1].y, t.s[2].y});
-  t.box_x0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-x0), 0));
-  t.box_y0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-y0), 0));
-  t.box_x1 = static_cast<int>(std::min<int64_t>(floorDiv8(x1), sp.width - 1));
-  t.box_y1 = static_cast<int>(std::min<int64_t>(floorDiv8(y1), sp.height - 1));
-  return t.box_x0 <= t.box_x1 && t.box_y0 <= t.box_y1;
+  return pixelBox(sp, x0, y0, x1, y1, t.box_x0, t.box_y0, t.box_x1, t.box_y1);
 }
 
 inline std::array<int64_t, 3> edgesAt(const Triangle& t, int x, int y) {
@@ -145,11 +157,8 @@ inline bool clipFace(const ScreenParams& sp, const Pose& pose, const std::array<
   c.z_near = c.z_far = kClipZ;
   int64_t x0 = INT64_MAX, y0 = INT64_MAX, x1 = INT64_MIN, y1 = INT64_MIN;
   for (int i = 0; i < m; ++i) {
-    const float rz = 1.0f / q[i].z();
-    const float sx = sp.fx * (q[i].x() * rz) + sp.cx;
-    const float sy = sp.fy * (q[i].y() * rz) + sp.cy;
-    if (!(std::abs(sx) < kGuardPx && std::abs(sy) < kGuardPx)) return false;
-    c.s[i] = {static_cast<int64_t>(std::floor(sx * kSubpixel + 0.5f)), static_cast<int64_t>(std::floor(sy * kSubpixel + 0.5f))};
+    float rz;
+    if (!projectPoint(sp, q[i], rz, c.s[i])) return false;
     x0 = std::min(x0, c.s[i].x), x1 = std::max(x1, c.s[i].x);
     y0 = std::min(y0, c.s[i].y), y1 = std::max(y1, c.s[i].y);
     c.z_far = std::max(c.z_far, q[i].z());
@@ -161,11 +170,7 @@ inline bool clipFace(const ScreenParams& sp, const Pose& pose, const std::array<
   }
   if (area == 0) return false;
   c.sign = area > 0 ? 1 : -1;
-  c.box_x0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-x0), 0));
-  c.box_y0 = static_cast<int>(std::max<int64_t>(-floorDiv8(-y0), 0));
-  c.box_x1 = static_cast<int>(std::min<int64_t>(floorDiv8(x1), sp.width - 1));
-  c.box_y1 = static_cast<int>(std::min<int64_t>(floorDiv8(y1), sp.height - 1));
-  return c.box_x0 <= c.box_x1 && c.box_y0 <= c.box_y1;
+  return pixelBox(sp, x0, y0, x1, y1, c.box_x0, c.box_y0, c.box_x1, c.box_y1);
 }
 
 inline bool insideClipped(const ClippedFace& c, int x, int y) {
