@@ -13,6 +13,7 @@
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pose/accept.hpp"
 #include "synth/scene.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"

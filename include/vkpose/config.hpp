@@ -258,6 +258,24 @@ struct VerifyParams {
   /// on clutter of other colours 0.25-0.40; LM-O's scans, of 10 cm and more, keep 0.2 (their
   /// correct poses agree from 0.33). -1: off.
   float small_part_min_colour_agreement = 0.45f;
+  /// The collision rate a candidate needs when stage 6's first start paired no scene pixel and
+  /// the second try moved it along the camera's axis (InitialPose::second_try_m). That move
+  /// searches the whole ray for a surface, so it finds one on whatever lies there: on the LM-O
+  /// frame a glue bottle placed on a box's face at the image's edge (collision 0.46); the cups
+  /// the move found on the lying stress set (off-axis starts 6-9 cm short) reach 0.87-0.95.
+  /// The larger of this and `threshold` counts.
+  float second_try_min_collision = 0.6f;
+  /// Twins: two candidates of one object whose refined centres lie closer than this share of
+  /// the diameter and whose rotations differ by less than twin_angle_deg are one candidate
+  /// twice; the worse is dropped before the alternatives are rendered (a small part's 64
+  /// candidates x 4 starts converge on a few instances: 4.6 of a bracket bin frame's 10.4 s).
+  float twin_distance_fraction = 0.05f;
+  float twin_angle_deg = 5.f;
+  /// Hopeless: a pose whose silhouette support is under this share of min_silhouette_support
+  /// is not rendered against its alternatives (it is rejected anyway). Not more than a fifth:
+  /// turned over, a bracket's outline changes enough that at half of it a correct detection
+  /// was lost.
+  float hopeless_support_share = 0.2f;
 };
 /// Throws InputError naming the bad value.
 void validateVerifyParams(const VerifyParams& params);

@@ -7,7 +7,8 @@
 //   frame.hpp       LinemodFrame (colour + depth), FeatureParams, loadFrame, image files
 //   bank.hpp        training (views, trainTemplates) and the template bank file
 //   config.hpp      DetectorParams: every stage's parameters, and the config file
-//   detector.hpp    Detector, Detection, the detection JSON and overlay pictures
+//   detection.hpp   Detection and DetectionResult: what the detector finds in a frame
+//   detector.hpp    Detector, the detection JSON and overlay pictures
 //   evaluation.hpp  BOP datasets, the paper's metrics, the baselines, runEvaluation
 //   synth.hpp       synthetic BOP datasets and the demo
 // Everything under src/ is internal and may change from one commit to the next (docs/api.md).
@@ -15,6 +16,7 @@
 
 #include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"
+#include "vkpose/detection.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/error.hpp"

@@ -95,6 +95,16 @@ void validateVerifyParams(const VerifyParams& params) {
       throw InputError(fmt::format("the look-alike tolerance must be in [0, 0.5] of the diameter, got {}", tolerance));
   if (!(params.min_contour_edges >= 0.f && params.min_contour_edges <= 1.f))
     throw InputError(fmt::format("the contour edge share must be in [0, 1], got {}", params.min_contour_edges));
+  if (!std::isfinite(params.second_try_min_collision))
+    throw InputError(fmt::format("the second try's collision rate must be finite, got {}",
+                                 params.second_try_min_collision));
+  if (!(params.twin_distance_fraction >= 0.f && params.twin_distance_fraction <= 1.f))
+    throw InputError(fmt::format("the twin distance must be in [0, 1] of the diameter, got {}",
+                                 params.twin_distance_fraction));
+  if (!(params.twin_angle_deg >= 0.f && params.twin_angle_deg <= 180.f))
+    throw InputError(fmt::format("the twin angle must be in [0, 180] degrees, got {}", params.twin_angle_deg));
+  if (!(params.hopeless_support_share >= 0.f && params.hopeless_support_share <= 1.f))
+    throw InputError(fmt::format("the hopeless support share must be in [0, 1], got {}", params.hopeless_support_share));
   for (const float agreement : {params.min_colour_agreement, params.small_part_min_colour_agreement})
     if (!(agreement >= -1.f && agreement <= 1.f))
       throw InputError(fmt::format("the colour agreement must be in [-1, 1], got {}", agreement));

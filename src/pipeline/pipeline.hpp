@@ -17,14 +17,6 @@ Camera frameCamera(const LinemodFrame& frame, const Camera& camera, const Featur
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera);
 
-/// Stage 8's duplicate test among one object's own verified poses: of two whose centres lie
-/// closer than duplicate_fraction of the diameter, the one with the higher score times the
-/// dense fit of its chosen look-alike alternative (where that check ran) stays; the other gets
-/// the rejection "the same place as a better OBJECT detection". Poses of different objects
-/// are left to the caller (ranked by the score alone: only some objects have that fit).
-void rejectSameObjectDuplicates(std::vector<Detection>& verified, const std::vector<TemplateBank>& banks,
-                                float duplicate_fraction);
-
 /// Stages 1-2's times under the names the detection JSON reports them by: "upload" (when the
 /// templates were uploaded), "features", "similarity", "match_readback".
 void appendMatchTimings(const MatchTimings& timings, StageTimings& to);

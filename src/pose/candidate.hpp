@@ -1,0 +1,117 @@
+#pragma once
+// Stages 6-8 over one frame (docs/pipeline.md): a pose candidate is one rotation start of a
+// hypothesis, and each stage is a function that fills in its part of every candidate:
+//   startCandidates    stage 6, rotations: each hypothesis's starts, posed on its viewing ray
+//   initialPoses       stage 6, translations: each start rendered and moved onto the scene
+//   smoothSceneCrops   stage 7, MLS of each candidate's scene crop
+//   refineCandidates   stage 7, ICP
+//   verifyCandidates   stage 8, the evidence: collision rate, depth agreement, outline tests
+// then alternatives.hpp (near-symmetries, look-alikes) and accept.hpp (the acceptance rules and
+// the competition between poses). Candidates are independent: each function runs them on
+// `threads` threads with results identical to one thread.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "hypotheses/hypotheses.hpp"
+#include "pose/initial_pose.hpp"
+#include "pose/point_cloud.hpp"
+#include "pose/refine.hpp"
+#include "pose/verify.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
+#include "vkpose/detection.hpp"
+#include "vkpose/geometry.hpp"
+
+namespace vkpose {
+
+class MeshRenderer;
+
+/// What stages 6-8 know of one object (one bank).
+struct PoseObject {
+  const TemplateBank* bank = nullptr;
+  MeshRenderer* renderer = nullptr;  ///< renders the object for stage 6 and the alternatives (GPU)
+  float bounding_radius = 0.f;       ///< farthest mesh vertex from bank->centre, metres
+  /// Its colours vary enough to tell near-symmetric turns apart (kMinChromaSpread).
+  bool colourful = false;
+  /// Look-alike half-turns (findLookAlikeTurns; empty for symmetric objects).
+  std::vector<NearSymmetry> look_alike_turns;
+};
+
+/// What stages 6-8 read of one frame.
+struct PoseFrame {
+  Camera camera;      ///< with the frame's size
+  cv::Mat depth_m;    ///< CV_32FC1 metres, 0 = none
+  cv::Mat bgr;        ///< CV_8UC3 of depth_m's size; black when the frame has no colour
+  ImageEdges edges;   ///< of bgr, for the contour test
+};
+
+/// The frame as stages 6-8 read it: a colour image that is missing or of another size than the
+/// depth is replaced by black (the tests then compare depth alone).
+PoseFrame poseFrame(const Camera& camera, const cv::Mat& depth_m, const cv::Mat& bgr);
+
+/// Stage 8's measurements of a refined pose (verify.hpp has each test).
+struct PoseEvidence {
+  VerifyResult collision;       ///< the octree collision rate phi
+  DepthAgreement depth;         ///< seen-through and fitting shares of the visible model
+  float silhouette_support = 0.f;
+  float contour_edges = 0.f;
+  std::vector<int> explained;   ///< the scene cells it explains (supportCells)
+};
+
+/// One start of stages 6-8 and what each stage found for it.
+struct PoseCandidate {
+  /// What stages 1-5 know of its hypothesis (hypothesisDetection); acceptPoses fills in the rest.
+  Detection detection;
+  Pose start;              ///< stage 6's rotation start on the viewing ray: where it renders
+  InitialPose initial;     ///< stage 6: the start moved onto the scene, its model and scene points
+  RefineParams refine;     ///< stages 7-8's parameters for its object at its distance (scaledForObject)
+  VerifyParams verify;
+  PointCloud smoothed;     ///< stage 7: the scene crop after MLS
+  RefineResult refined;    ///< stage 7: ICP's pose
+  PoseEvidence evidence;   ///< stage 8
+  /// ICP brought it to the pose of a better candidate (markTwins): not compared or accepted.
+  bool twin = false;
+  double cpu_ms = 0;       ///< stages 7-8's CPU time for this candidate
+
+  std::size_t bank() const { return static_cast<std::size_t>(detection.bank); }
+};
+
+/// What stages 1-5 know about a hypothesis: its score, image position, best template and box.
+Detection hypothesisDetection(const Hypothesis& h, const std::vector<TemplateBank>& banks);
+
+/// Stage 6, rotations: for each hypothesis its largest rotation group (initialRotation), and
+/// for a small part (InitialPoseParams::small_part_starts) or a bank with other resting poses
+/// (resting_poses_starts) the next largest, then the group that fits best by stage 4 where
+/// that is another; each posed on the hypothesis's viewing ray (poseOnViewingRay).
+std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypotheses,
+                                           const std::vector<TemplateBank>& banks, const Camera& camera,
+                                           const DetectorParams& params);
+
+/// Stage 6, translations: each start rendered in its own window (projectedWindow: one small
+/// submit each) and moved by the centroid difference (initialTranslation); then each
+/// candidate's stage 7-8 parameters, scaled for its object at its distance, with the higher
+/// collision rate a start moved along the camera's axis needs (second_try_min_collision).
+void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                  const PoseFrame& frame, const DetectorParams& params);
+
+/// Stage 7, first step: each candidate's scene crop smoothed by MLS (RefineParams::mls).
+void smoothSceneCrops(std::vector<PoseCandidate>& candidates, unsigned threads);
+
+/// Stage 7, second step: ICP of each candidate's model points onto its smoothed crop.
+void refineCandidates(std::vector<PoseCandidate>& candidates, unsigned threads);
+
+/// Stage 8's measurements of `model_points` (object frame) at `pose` against the scene.
+PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const PointCloud& scene_points,
+                         const PoseFrame& frame, const VerifyParams& params);
+
+/// Stage 8: a refined candidate's evidence (measurePose at its refined pose), its time added
+/// to cpu_ms.
+void verifyCandidate(PoseCandidate& candidate, const PoseFrame& frame);
+
+/// Stage 8: verifyCandidate for every candidate that stage 6 placed.
+void verifyCandidates(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads);
+
+}  // namespace vkpose
