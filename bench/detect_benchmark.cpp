@@ -236,6 +236,9 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
     report.mean_detections += static_cast<double>(r.detections.size()) / o.frames;
     detections.push_back(r.detections.size());
     refine_cpu_ms += r.refine_cpu_ms;
+    report.pose_wall_ms += r.pose_wall_ms / o.frames;
+    report.pose_cpu_ms += r.pose_cpu_ms / o.frames;
+    report.pose_threads = std::max(report.pose_threads, r.pose_threads);
     refined += static_cast<double>(r.refined_candidates);
     accepted += static_cast<double>(r.detections.size());
     report_progress("detect", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
@@ -319,8 +322,11 @@ std::string formatDetectReport(const DetectBenchReport& r) {
                      r.frames_per_s, r.mean_matches, r.mean_hypotheses, r.mean_detections);
   if (r.mean_refined > 0)
     out += fmt::format("pose stages: {:.1f} candidates refined a frame, {:.1f} CPU ms each (MLS, ICP, verification on "
-                       "one core), {:.1f} refined per detection\n",
-                       r.mean_refined, r.refine_ms_per_candidate, r.refined_per_detection);
+                       "one core), {:.1f} refined per detection\n"
+                       "pose stages 6-8 a frame: wall {:.1f} ms, CPU {:.1f} ms on {} thread{} (wall / CPU {:.2f})\n",
+                       r.mean_refined, r.refine_ms_per_candidate, r.refined_per_detection, r.pose_wall_ms,
+                       r.pose_cpu_ms, r.pose_threads, r.pose_threads == 1 ? "" : "s",
+                       r.pose_cpu_ms > 0 ? r.pose_wall_ms / r.pose_cpu_ms : 0.0);
   out += r.pruned_share > 0 || r.skipped_share > 0
              ? fmt::format("depth-guided pruning: {:.1f} % of the (template, position) pairs pruned, {:.1f} % skipped "
                            "unread\n",
@@ -361,6 +367,10 @@ nlohmann::json detectReportJson(const DetectBenchReport& r) {
                       {"mean_refined_candidates", r.mean_refined},
                       {"refine_cpu_ms_per_candidate", r.refine_ms_per_candidate},
                       {"refined_per_detection", r.refined_per_detection},
+                      {"pose_stages", {{"wall_ms", r.pose_wall_ms},
+                                       {"cpu_ms", r.pose_cpu_ms},
+                                       {"threads", r.pose_threads},
+                                       {"wall_to_cpu", r.pose_cpu_ms > 0 ? r.pose_wall_ms / r.pose_cpu_ms : 0.0}}},
                       {"pruned_share", r.pruned_share},
                       {"skipped_share", r.skipped_share},
                       {"memory", {{"peak_rss_bytes", r.peak_rss_bytes},

@@ -59,8 +59,12 @@ struct DetectBenchReport {
   bool in_flight_same_detections = true;
   double mean_matches = 0, mean_hypotheses = 0, mean_detections = 0;
   /// Stages 7-8's budget: candidates refined a frame, their CPU ms each (one core), and
-  /// refined candidates per accepted detection (issue 21's goals: <= 15 ms, <= 2).
+  /// refined candidates per accepted detection.
   double mean_refined = 0, refine_ms_per_candidate = 0, refined_per_detection = 0;
+  /// Stages 6-8 a frame (mean): wall ms, the process's CPU ms meanwhile (all threads), and the
+  /// most threads their candidates ran on (DetectorParams::threads).
+  double pose_wall_ms = 0, pose_cpu_ms = 0;
+  unsigned pose_threads = 0;
   /// Depth-guided pruning over the timed frames: shares of the coarse pass's (template,
   /// position) pairs pruned, and skipped whole by the GPU (both 0 when off).
   double pruned_share = 0, skipped_share = 0;

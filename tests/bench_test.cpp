@@ -1,6 +1,8 @@
 // The benchmarks' pure parts (percentiles, the SVG plot) and `bench detect` end to end on one
 // synthetic frame of a small bank.
+#include <algorithm>
 #include <filesystem>
+#include <thread>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -120,7 +122,7 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   double sum = 0;
   for (std::size_t i = 0; i < stages.size(); ++i) {
     EXPECT_EQ(r.stages[i].stage, stages[i]);
-    EXPECT_GE(r.stages[i].median_ms, 0.0);
+    EXPECT_GT(r.stages[i].median_ms, 0.0) << stages[i] << " took no time: not timed?";
     EXPECT_DOUBLE_EQ(r.stages[i].median_ms, r.stages[i].p95_ms);  // one frame: one value
     if (i + 1 < stages.size()) sum += r.stages[i].median_ms;
   }
@@ -137,6 +139,16 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   for (const auto& s : stages) EXPECT_TRUE(j.at("stages").contains(s)) << s;
   EXPECT_TRUE(j.at("memory").contains("gpu_peak_bytes"));
   EXPECT_TRUE(j.contains("opencv"));
+  // The pose stages' wall and CPU time and their threads.
+  EXPECT_GT(r.pose_wall_ms, 0.0);
+  EXPECT_GT(r.pose_cpu_ms, 0.0);
+  // At most every core, at most one a candidate (none when the frame had no candidate).
+  EXPECT_LE(r.pose_threads, std::max(1u, std::thread::hardware_concurrency()));
+  if (r.mean_refined > 0) {
+    EXPECT_GE(r.pose_threads, 1u);
+  }
+  EXPECT_EQ(j.at("pose_stages").at("threads").get<unsigned>(), r.pose_threads);
+  EXPECT_NEAR(j.at("pose_stages").at("wall_to_cpu").get<double>(), r.pose_wall_ms / r.pose_cpu_ms, 1e-9);
 }
 
 TEST(BenchDetect, BadInputIsAnInputError) {

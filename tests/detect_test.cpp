@@ -37,12 +37,13 @@ struct IcbinResult {
   std::string json;
 };
 
-IcbinResult detectIcbinScene2(bool poses) {
+IcbinResult detectIcbinScene2(bool poses, unsigned threads = 0) {
   const std::string d = test::sharedData() + "/icbin/";
   const Camera camera = loadCamera(d + "camera.json");
   const LinemodFrame frame = loadFrame(d + "scene2/rgb/0000.png", d + "scene2/depth/0000.png", camera.depth_scale);
   DetectorParams params;
   params.estimate_poses = poses;
+  params.threads = threads;
   Detector detector(test::context(), {icbinCupBank()}, params);
   IcbinResult out;
   out.result = detector.detect(frame, camera);
@@ -164,6 +165,29 @@ TEST(DetectIcbin, WritesTheDetectionJsonScriptsRelyOn) {
     ASSERT_TRUE(t.contains(stage)) << stage;
     EXPECT_GE(t.at(stage).get<double>(), 0.0);
   }
+}
+
+TEST(DetectIcbin, PoseStagesOnOneThreadFindTheSameAsOnMany) {
+  // Stages 6-8 run their candidates on DetectorParams::threads threads; the detections, the
+  // rejected candidates and their order must not depend on how many (timings aside).
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const IcbinResult one = detectIcbinScene2(true, 1);
+  const IcbinResult& many = icbinScene2Poses();  // every core (at least 2 on any CI machine)
+  const IcbinResult four = detectIcbinScene2(true, 4);
+  auto withoutTimings = [](const std::string& json) {
+    auto doc = nlohmann::json::parse(json);
+    doc.erase("timings_ms");
+    return doc;
+  };
+  EXPECT_EQ(one.result.pose_threads, 1u);
+  EXPECT_EQ(four.result.pose_threads, 4u);
+  ASSERT_GT(one.result.refined_candidates, 4u);
+  ASSERT_FALSE(one.result.detections.empty());
+  EXPECT_EQ(one.result.refined_candidates, many.result.refined_candidates);
+  EXPECT_EQ(withoutTimings(one.json), withoutTimings(many.json));
+  EXPECT_EQ(withoutTimings(one.json), withoutTimings(four.json));
+  EXPECT_GT(one.result.pose_wall_ms, 0.0);
+  EXPECT_GT(one.result.pose_cpu_ms, 0.0);
 }
 
 TEST(DetectIcbin, FramesInFlightFindWhatFrameByFrameFinds) {

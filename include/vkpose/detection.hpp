@@ -95,6 +95,12 @@ struct DetectionResult {
   /// candidate timed on its own thread: the cost on one core, whatever the thread count).
   std::size_t refined_candidates = 0;
   double refine_cpu_ms = 0;
+  /// Stages 6-8 as a whole: their wall time, the CPU time the process spent meanwhile (all
+  /// threads, the Vulkan driver's too), and the threads their candidates ran on
+  /// (DetectorParams::threads, at most one a candidate). On N threads the wall time is about
+  /// 1/N of the CPU time when the pose stages keep every thread busy.
+  double pose_wall_ms = 0, pose_cpu_ms = 0;
+  unsigned pose_threads = 0;
   std::vector<std::string> warnings;  ///< e.g. a bank trained for another focal length
 };
 

@@ -41,6 +41,9 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str();
   sub->add_flag("!--no-pose", options->params.estimate_poses, "Stop after NMS (stages 1-5 only)");
+  sub->add_option("--threads", options->params.threads,
+                  "CPU threads for the pose stages (0: every core); results are the same for any count")
+      ->capture_default_str();
   sub->add_flag("!--no-opencv", options->run_opencv, "Skip the cv::linemod baseline");
   sub->add_flag("!--no-depth-pruning", options->params.match.depth_pruning,
                 "Score every template at every position (the matcher before depth-guided pruning), to compare");

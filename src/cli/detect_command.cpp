@@ -292,6 +292,10 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str()
       ->group(stages);
+  sub->add_option("--threads", p.threads,
+                  "CPU threads for the pose stages (0: every core); results are the same for any count")
+      ->capture_default_str()
+      ->group(stages);
   sub->add_option("--pose-candidates", p.pose_candidates_per_object,
                   "Hypotheses per object that get a pose and verification (the best after NMS)")
       ->check(CLI::PositiveNumber)

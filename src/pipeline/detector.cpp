@@ -242,6 +242,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   const PoseFrame frame = poseFrame(scene.camera, scene.depth_m, frame_bgr);
   const unsigned threads = params_.threads;
   auto t0 = std::chrono::steady_clock::now();
+  const auto wall0 = t0;
+  const double cpu0 = util::processCpuMs();
   // Stage 6: one or more rotation starts a hypothesis, each rendered and moved onto the scene.
   std::vector<PoseCandidate> candidates = startCandidates(clusters, banks_, frame.camera, params_);
   attachRenderers();
@@ -269,6 +271,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   acceptPoses(candidates, banks_, frame.camera, params_, result);
   result.timings_ms.emplace_back("verification", msSince(t0) - symmetries_ms);
   result.timings_ms.emplace_back("symmetries", symmetries_ms);
+  result.pose_wall_ms = msSince(wall0);
+  result.pose_cpu_ms = util::processCpuMs() - cpu0;
+  result.pose_threads = util::threadsFor(candidates.size(), threads);
 }
 
 void Detector::attachRenderers() {

@@ -10,12 +10,18 @@
 
 namespace vkpose::util {
 
+/// The threads parallelFor runs n items on: `threads` (0: all cores), at most n.
+inline unsigned threadsFor(std::size_t n, unsigned threads = 0) {
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<unsigned>(std::min<std::size_t>(threads, n));
+}
+
 /// Calls fn(i) for i in [0, n) on up to `threads` threads (0: all cores). The first exception
-/// thrown by any item is rethrown here after all threads stop.
+/// thrown by any item is rethrown here after all threads stop. Each item's result goes to its
+/// own slot (callers index by i), so the results do not depend on the thread count.
 template <class Fn>
 void parallelFor(std::size_t n, Fn&& fn, unsigned threads = 0) {
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  threads = threadsFor(n, threads);
   if (threads <= 1) {
     for (std::size_t i = 0; i < n; ++i) fn(i);
     return;
