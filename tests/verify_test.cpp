@@ -9,7 +9,7 @@
 
 #include "cloud_support.hpp"
 #include "mesh_support.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "pose/refine.hpp"
 #include "pose/verify.hpp"
 #include "test_support.hpp"

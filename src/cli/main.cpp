@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", global.quiet, "Print only results and errors");
   app.add_flag("-v,--verbose", global.verbose, "Print more detail (e.g. why each rejected hypothesis was rejected)");
+  // The global flags work after the subcommand too (`vkpose detect ... -v`): what a
+  // subcommand does not know goes up to its parent.
+  app.fallthrough();
   app.footer(
       "Exit codes: 0 ok, 1 bad input (missing or corrupt file, bad value), 2 usage error, 3 no usable Vulkan "
       "device.");

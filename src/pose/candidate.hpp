@@ -17,7 +17,7 @@
 
 #include "hypotheses/hypotheses.hpp"
 #include "pose/initial_pose.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "pose/refine.hpp"
 #include "pose/verify.hpp"
 #include "vkpose/bank.hpp"

@@ -14,7 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "hypotheses/hypotheses.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "render/render.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"

@@ -12,7 +12,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "pose/nearest_neighbours.hpp"
+#include "geometry/nearest_neighbours.hpp"
 #include "pose/refine.hpp"
 
 namespace vkpose {

@@ -10,8 +10,8 @@
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 
-#include "pose/nearest_neighbours.hpp"
-#include "pose/point_cloud.hpp"
+#include "geometry/nearest_neighbours.hpp"
+#include "geometry/point_cloud.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/geometry.hpp"
 

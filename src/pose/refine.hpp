@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/geometry.hpp"
 

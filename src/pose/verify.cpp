@@ -12,7 +12,7 @@
 #include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
 
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "render/render.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/geometry.hpp"

@@ -7,7 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/geometry.hpp"
 

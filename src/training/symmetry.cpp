@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
-#include "pose/nearest_neighbours.hpp"
+#include "geometry/nearest_neighbours.hpp"
 
 namespace vkpose {
 

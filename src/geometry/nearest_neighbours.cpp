@@ -1,4 +1,4 @@
-#include "pose/nearest_neighbours.hpp"
+#include "geometry/nearest_neighbours.hpp"
 
 #include <algorithm>
 #include <cmath>

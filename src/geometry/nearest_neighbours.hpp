@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "pose/point_cloud.hpp"
+#include "geometry/point_cloud.hpp"
 
 namespace vkpose {
 
