@@ -81,6 +81,17 @@ struct Camera {
   Eigen::Vector2f project(const Eigen::Vector3f& p) const {
     return {static_cast<float>(fx * p.x() / p.z() + cx), static_cast<float>(fy * p.y() / p.z() + cy)};
   }
+  /// The viewing ray through pixel (x, y): the camera-frame point at depth 1 there (computed
+  /// in double, rounded to float once).
+  Eigen::Vector3f ray(double x, double y) const {
+    return {static_cast<float>((x - cx) / fx), static_cast<float>((y - cy) / fy), 1.f};
+  }
+  /// The camera-frame point at pixel (x, y) with depth z (metres along the optical axis): the
+  /// inverse of project.
+  Eigen::Vector3f backProject(double x, double y, float z) const {
+    const Eigen::Vector3f r = ray(x, y);
+    return {r.x() * z, r.y() * z, z};
+  }
 };
 
 /// Throws InputError when a focal length is not positive and finite, the principal point is

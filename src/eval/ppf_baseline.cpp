@@ -36,14 +36,13 @@ Eigen::Vector3f rowPoint(const cv::Mat& pc, int i) {
 cv::Mat sceneCloud(const cv::Mat& depth_mm, const Camera& camera, const PpfParams& p) {
   const ScoreScene scene = makeScoreScene(depth_mm, camera);
   std::vector<cv::Vec6f> rows;
-  const float ifx = static_cast<float>(1.0 / camera.fx), ify = static_cast<float>(1.0 / camera.fy);
   for (int y = 0; y < depth_mm.rows; y += p.pixel_step)
     for (int x = 0; x < depth_mm.cols; x += p.pixel_step) {
       Eigen::Vector3f n;
       if (!score::sceneNormal(scene, x, y, p.normal_step_px, p.normal_max_jump_m, n)) continue;
       const float z = scene.depth_m.at<float>(y, x);
-      rows.emplace_back((static_cast<float>(x) - static_cast<float>(camera.cx)) * ifx * z,
-                        (static_cast<float>(y) - static_cast<float>(camera.cy)) * ify * z, z, n.x(), n.y(), n.z());
+      const Eigen::Vector3f point = score::backProject(scene, x, y, z);
+      rows.emplace_back(point.x(), point.y(), point.z(), n.x(), n.y(), n.z());
     }
   return cv::Mat(static_cast<int>(rows.size()), 6, CV_32F, rows.data()).clone();
 }

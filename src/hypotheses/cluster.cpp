@@ -171,8 +171,7 @@ cv::Rect2f templateBox(const Hypothesis& h, const BankTemplate& t) {
 }
 
 Eigen::Matrix3f viewingRayRotation(float x, float y, const Camera& camera) {
-  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
-                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  const Eigen::Vector3f ray = camera.ray(x, y);
   return Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), ray.normalized()).toRotationMatrix();
 }
 

@@ -35,6 +35,14 @@ inline float sceneDepth(const cv::Mat& depth_m, int x, int y) {
 /// The scene normal at (x, y): the cross product of the back-projected depth differences
 /// `step` pixels either side, turned towards the camera. False at depth edges, holes and the
 /// image border.
+/// The camera-frame point at pixel (u, v) with depth d, in the float arithmetic of the cluster
+/// score kernel (cluster_score.comp): float intrinsics, the focal lengths' reciprocals.
+inline Eigen::Vector3f backProject(const ScoreScene& s, int u, int v, float d) {
+  const float ifx = static_cast<float>(1.0 / s.camera.fx), ify = static_cast<float>(1.0 / s.camera.fy);
+  const float cx = static_cast<float>(s.camera.cx), cy = static_cast<float>(s.camera.cy);
+  return {(static_cast<float>(u) - cx) * ifx * d, (static_cast<float>(v) - cy) * ify * d, d};
+}
+
 inline bool sceneNormal(const ScoreScene& s, int x, int y, int step, float max_jump, Eigen::Vector3f& n) {
   const float z = sceneDepth(s.depth_m, x, y);
   const float zl = sceneDepth(s.depth_m, x - step, y), zr = sceneDepth(s.depth_m, x + step, y);
@@ -43,11 +51,7 @@ inline bool sceneNormal(const ScoreScene& s, int x, int y, int step, float max_j
   if (std::abs(zl - z) > max_jump || std::abs(zr - z) > max_jump || std::abs(zu - z) > max_jump ||
       std::abs(zd - z) > max_jump)
     return false;
-  const float ifx = static_cast<float>(1.0 / s.camera.fx), ify = static_cast<float>(1.0 / s.camera.fy);
-  const float cx = static_cast<float>(s.camera.cx), cy = static_cast<float>(s.camera.cy);
-  auto point = [&](int u, int v, float d) {
-    return Eigen::Vector3f((static_cast<float>(u) - cx) * ifx * d, (static_cast<float>(v) - cy) * ify * d, d);
-  };
+  auto point = [&](int u, int v, float d) { return backProject(s, u, v, d); };
   const Eigen::Vector3f dx = point(x + step, y, zr) - point(x - step, y, zl);
   const Eigen::Vector3f dy = point(x, y + step, zd) - point(x, y - step, zu);
   Eigen::Vector3f c = dx.cross(dy);

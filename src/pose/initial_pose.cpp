@@ -127,15 +127,13 @@ Pose poseOnViewingRay(const Eigen::Matrix3f& R, const Hypothesis& h, const Templ
 }
 
 float rangeOnRay(float template_range, float depth_offset, float x, float y, const Camera& camera) {
-  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
-                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  const Eigen::Vector3f ray = camera.ray(x, y);
   return (template_range + depth_offset) * ray.norm();  // ray.norm() = 1 / cos(theta)
 }
 
 Pose poseAtRange(const Eigen::Matrix3f& R, float x, float y, float range, const Eigen::Vector3f& centre,
                  const Camera& camera) {
-  const Eigen::Vector3f ray(static_cast<float>((x - camera.cx) / camera.fx),
-                            static_cast<float>((y - camera.cy) / camera.fy), 1.f);
+  const Eigen::Vector3f ray = camera.ray(x, y);
   Pose p;
   p.R = R;
   p.t = ray.normalized() * range - R * centre;
@@ -180,8 +178,7 @@ PointCloud visibleModelPoints(const Rendering& rendering, const Pose& pose, cons
     for (int u = window.x; u < window.x + window.width; ++u) {
       const float z = zr[u - window.x];
       if (!(z > 0.f)) continue;
-      const Eigen::Vector3f pm(static_cast<float>((u - camera.cx) / camera.fx) * z,
-                               static_cast<float>((v - camera.cy) / camera.fy) * z, z);
+      const Eigen::Vector3f pm = camera.backProject(u, v, z);
       out.push_back(R_inv * (pm - pose.t));
     }
   }
@@ -199,10 +196,7 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
                                  rendering.depth.cols, rendering.depth.rows, window.width, window.height,
                                  scene_depth_m.cols, scene_depth_m.rows));
   const float band = params.depth_band_fraction * diameter;
-  auto backProject = [&](int u, int v, float z) {
-    return Eigen::Vector3f(static_cast<float>((u - camera.cx) / camera.fx) * z,
-                           static_cast<float>((v - camera.cy) / camera.fy) * z, z);
-  };
+  auto backProject = [&](int u, int v, float z) { return camera.backProject(u, v, z); };
   InitialPose out;
   out.pose = rendered;
   Eigen::Vector3d scene_sum = Eigen::Vector3d::Zero(), model_sum = Eigen::Vector3d::Zero();

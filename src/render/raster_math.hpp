@@ -38,6 +38,11 @@ struct ScreenParams {
   explicit ScreenParams(const Camera& c)
       : fx(static_cast<float>(c.fx)), fy(static_cast<float>(c.fy)), cx(static_cast<float>(c.cx)),
         cy(static_cast<float>(c.cy)), width(c.width), height(c.height) {}
+  /// The viewing ray through pixel (x, y) at depth 1, as the raster kernels compute it (the
+  /// focal lengths' float reciprocals).
+  Eigen::Vector3f ray(int x, int y) const {
+    return {(static_cast<float>(x) - cx) * (1.0f / fx), (static_cast<float>(y) - cy) * (1.0f / fy), 1.0f};
+  }
 };
 
 inline Eigen::Vector3f toCamera(const Pose& pose, const Eigen::Vector3f& v) {
@@ -110,8 +115,8 @@ inline std::array<int64_t, 3> edgesAt(const Triangle& t, int x, int y) {
 
 inline float planeDepthAt(const ScreenParams& sp, const Eigen::Vector3f& n, float n_p0, float z_near, float z_far,
                           int x, int y) {
-  const float rx = (static_cast<float>(x) - sp.cx) * (1.0f / sp.fx), ry = (static_cast<float>(y) - sp.cy) * (1.0f / sp.fy);
-  const float denom = n.x() * rx + n.y() * ry + n.z() * 1.0f;
+  const Eigen::Vector3f r = sp.ray(x, y);
+  const float denom = n.x() * r.x() + n.y() * r.y() + n.z() * 1.0f;
   const float z = denom != 0.0f ? n_p0 * (1.0f / denom) : z_far;
   return std::clamp(z, z_near, z_far);
 }

@@ -95,8 +95,7 @@ Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& po
              static_cast<float>(e[2]) * inv_area * t.rz[2] * z};
         face_n = t.n;
       } else {  // a clipped face: weights from its corners in the camera frame
-        const Eigen::Vector3f point((static_cast<float>(x) - sp.cx) * (1.0f / sp.fx),
-                                    (static_cast<float>(y) - sp.cy) * (1.0f / sp.fy), 1.0f);
+        const Eigen::Vector3f point = sp.ray(x, y);
         w = render::faceWeights(pose, corners(idx), point * z, face_n);
       }
       Eigen::Vector3f n;

@@ -55,8 +55,7 @@ std::optional<Pose> tryOnTable(const Mesh& mesh, const std::vector<RestingOrient
   const float m = params.image_margin;
   const float u = uniform(rng, m, 1.f - m) * static_cast<float>(camera.width);
   const float v = uniform(rng, m, 1.f - m) * static_cast<float>(camera.height);
-  const Eigen::Vector3f ray_cam(static_cast<float>((u - camera.cx) / camera.fx),
-                                static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+  const Eigen::Vector3f ray_cam = camera.ray(u, v);
   const Eigen::Vector3f ray = world_T_camera.R * ray_cam, origin = world_T_camera.t;
   const RestingOrientation& r = pickResting(rest, rng);
   const float turn = uniform(rng, 0.f, 2.f * kPi);

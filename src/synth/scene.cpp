@@ -209,8 +209,7 @@ void applyLighting(SceneRendering& scene, const Lighting& light) {
       const float lambert = std::max(0.f, n.dot(to_light));
       // Phong: the light mirrored about the normal against the direction to the camera.
       const Eigen::Vector3f to_eye =
-          -Eigen::Vector3f(static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f)
-               .normalized();
+          -cam.ray(x, y).normalized();
       const Eigen::Vector3f mirrored = 2.f * n.dot(to_light) * n - to_light;
       const float highlight =
           lambert > 0.f ? light.specular * 255.f * std::pow(std::max(0.f, mirrored.dot(to_eye)), light.shininess) : 0.f;
@@ -234,9 +233,7 @@ void dropGrazingAndHoles(const SceneRendering& scene, const DepthNoiseParams& no
       for (int x = 0; x < depth_mm.cols; ++x) {
         if (scene.depth.at<float>(y, x) <= 0.f) continue;
         const cv::Vec3f& n = scene.normals.at<cv::Vec3f>(y, x);
-        const Eigen::Vector3f ray =
-            Eigen::Vector3f(static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f)
-                .normalized();
+        const Eigen::Vector3f ray = cam.ray(x, y).normalized();
         const float cos_angle = std::abs(n[0] * ray.x() + n[1] * ray.y() + n[2] * ray.z());
         const float u = uniform(rng);  // drawn for every surface pixel: reproducible layout
         if (cos_angle < start && u < noise.grazing_dropout * (start - cos_angle) / start)

@@ -104,8 +104,7 @@ void addTable(ImageScene& s, const Camera& camera, float z, std::mt19937& rng) {
   const Pose world_T_camera = invert(s.camera_T_world);
   float reach = 0.f;
   for (const auto& [u, v] : {std::pair{0, 0}, {camera.width, 0}, {0, camera.height}, {camera.width, camera.height}}) {
-    const Eigen::Vector3f ray = world_T_camera.R * Eigen::Vector3f(static_cast<float>((u - camera.cx) / camera.fx),
-                                                                   static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+    const Eigen::Vector3f ray = world_T_camera.R * camera.ray(u, v);
     const Eigen::Vector3f& o = world_T_camera.t;
     if (ray.z() >= -1e-3f) {
       reach = 4.f;
