@@ -17,6 +17,31 @@ namespace vkpose::cli {
 
 using util::ProgressBar;
 
+namespace {
+
+/// `bench detect --sweep`: the frame time over object or instance counts, as JSON and an SVG plot.
+ExitCode runSweep(const bench::DetectBenchOptions& options, const std::string& sweep, const std::vector<int>& counts,
+             const std::string& json_path, const GlobalOptions& global, const bench::BenchProgress& show,
+             std::unique_ptr<ProgressBar>& bar) {
+  if (json_path.empty()) throw InputError("--sweep writes its JSON and an SVG plot next to it: give --json FILE");
+  const std::string svg_path = std::filesystem::path(json_path).replace_extension(".svg").string();
+  if (std::filesystem::exists(svg_path))
+    throw InputError("'" + svg_path + "' exists; vkpose does not overwrite results (remove it first)");
+  const auto kind = sweep == "objects" ? bench::DetectSweep::Objects : bench::DetectSweep::Instances;
+  const std::vector<int> n = !counts.empty() ? counts
+                             : kind == bench::DetectSweep::Objects ? std::vector<int>{1, 3, 8, 20}
+                                                                    : std::vector<int>{1, 2, 4, 8};
+  const auto rows = bench::runDetectSweep(options, kind, n, global.gpu(), show);
+  bar.reset();
+  fmt::print("{}", bench::formatDetectSweep(rows, kind));
+  writeTextFile(json_path, bench::detectSweepJson(rows, kind).dump(2) + "\n", false);
+  writeTextFile(svg_path, bench::detectSweepSvg(rows, kind), false);
+  if (!global.quiet) fmt::print("wrote {} and {}\n", json_path, svg_path);
+  return kOk;
+}
+
+}  // namespace
+
 Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
   auto* sub = bench.add_subcommand(
       "detect", "The whole detector (stages 1-8) over N frames: per-stage median and p95 ms, frames/s, memory, "
@@ -77,23 +102,7 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
       }
       bar->update(done, total);
     };
-    if (!sweep->empty()) {
-      if (json_path->empty()) throw InputError("--sweep writes its JSON and an SVG plot next to it: give --json FILE");
-      const std::string svg_path = std::filesystem::path(*json_path).replace_extension(".svg").string();
-      if (std::filesystem::exists(svg_path))
-        throw InputError("'" + svg_path + "' exists; vkpose does not overwrite results (remove it first)");
-      const auto kind = *sweep == "objects" ? bench::DetectSweep::Objects : bench::DetectSweep::Instances;
-      const std::vector<int> n = !counts->empty() ? *counts
-                                 : kind == bench::DetectSweep::Objects ? std::vector<int>{1, 3, 8, 20}
-                                                                        : std::vector<int>{1, 2, 4, 8};
-      const auto rows = bench::runDetectSweep(*options, kind, n, global.gpu(), show);
-      bar.reset();
-      fmt::print("{}", bench::formatDetectSweep(rows, kind));
-      writeTextFile(*json_path, bench::detectSweepJson(rows, kind).dump(2) + "\n", false);
-      writeTextFile(svg_path, bench::detectSweepSvg(rows, kind), false);
-      if (!global.quiet) fmt::print("wrote {} and {}\n", *json_path, svg_path);
-      return kOk;
-    }
+    if (!sweep->empty()) return runSweep(*options, *sweep, *counts, *json_path, global, show, bar);
     if (!counts->empty()) throw InputError("--counts goes with --sweep");
     const auto report = bench::runDetectBenchmark(*options, global.gpu(), show);
     bar.reset();

@@ -13,6 +13,90 @@
 
 namespace vkpose::cli {
 
+namespace {
+
+/// The rows as a table on stdout, and as the JSON array `--json` writes.
+nlohmann::json printMatchRows(const std::vector<bench::MatchBenchRow>& rows) {
+  fmt::print("{:>7}  {:>9}  {:>11}  {:>11}  {:>6}  {:>9}  {:>9}  {:>6}  {:>10}  {:>10}  {:>10}\n", "objects",
+             "templates", "vkpose ms", "opencv ms", "ratio", "matches", "opencv", "passes", "GPU peak", "RSS",
+             "peak RSS");
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : rows) {
+    fmt::print("{:>7}  {:>9}  {:>11.1f}  {:>11}  {:>6}  {:>9}  {:>9}  {:>6}  {:>10}  {:>10}  {:>10}\n",
+               r.objects > 0 ? std::to_string(r.objects) : "-", r.templates, r.vkpose_ms,
+               r.opencv_ms > 0 ? fmt::format("{:.1f}", r.opencv_ms) : "-",
+               r.opencv_ms > 0 ? fmt::format("{:.2f}", r.ratio) : "-", r.vkpose_matches,
+               r.opencv_ms > 0 ? std::to_string(r.opencv_matches) : "-",
+               r.attempts > r.passes ? fmt::format("{}/{}", r.passes, r.attempts) : std::to_string(r.passes),
+               bench::formatBytes(r.gpu_peak_bytes), bench::formatBytes(r.rss_bytes),
+               bench::formatBytes(r.peak_rss_bytes));
+    nlohmann::json row = {{"templates", r.templates},
+                          {"device", r.device},
+                          {"vkpose_ms", r.vkpose_ms},
+                          {"vkpose_matches", r.vkpose_matches},
+                          {"passes", r.passes},
+                          {"attempts", r.attempts},
+                          {"coarse_candidates", r.coarse_candidates},
+                          {"gpu_peak_bytes", r.gpu_peak_bytes},
+                          {"rss_bytes", r.rss_bytes},
+                          {"peak_rss_bytes", r.peak_rss_bytes}};
+    if (r.objects > 0) row["objects"] = r.objects;
+    if (r.opencv_ms > 0) {
+      row["opencv_ms"] = r.opencv_ms;
+      row["ratio"] = r.ratio;
+      row["opencv_matches"] = r.opencv_matches;
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
+/// `vkpose bench match`.
+ExitCode runBenchMatch(bench::MatchBenchOptions options, const std::string& json_path, const std::string& sweep,
+                       bool templates_given, const GlobalOptions& global) {
+  if (options.rgb.empty() != options.depth.empty()) throw InputError("--rgb and --depth go together");
+  if (!json_path.empty() && std::ifstream(json_path).good())
+    throw InputError("'" + json_path + "' exists; vkpose does not overwrite results (remove it first)");
+  std::string svg_path;
+  if (!sweep.empty()) {
+    if (json_path.empty()) throw InputError("--sweep writes its JSON and an SVG plot next to it: give --json FILE");
+    svg_path = std::filesystem::path(json_path).replace_extension(".svg").string();
+    if (std::filesystem::exists(svg_path))
+      throw InputError("'" + svg_path + "' exists; vkpose does not overwrite results (remove it first)");
+    if (sweep == "templates") {
+      options.sweep = bench::MatchSweep::Templates;
+      if (!templates_given) options.template_counts = bench::templateSweepCounts();
+    } else {
+      options.sweep = bench::MatchSweep::Objects;
+    }
+  } else if (!options.bank.empty()) {
+    throw InputError("--bank is for --sweep objects");
+  }
+  options.progress = !global.quiet && isatty(STDERR_FILENO);
+  std::string frame;
+  const auto rows = bench::runMatchBenchmark(options, global.gpu(), frame);
+  fmt::print("LINEMOD matching, both modalities, T = {{5, 8}}, threshold {} %, median of {} runs\n",
+             options.threshold, options.repeats);
+  fmt::print("frame: {}\n\n", frame);
+  fmt::print("device: {}\n\n", rows.empty() ? "" : rows.front().device);
+  const nlohmann::json out = printMatchRows(rows);
+  fmt::print("(passes: similarity passes, /submits when some overflowed and ran again; GPU peak: our GPU buffers at "
+             "most at once; RSS: resident after vkpose's runs; peak RSS: the process so far)\n");
+  bench::printKernelProfile();
+  if (!json_path.empty()) {
+    std::ofstream f(json_path);
+    if (!f) throw InputError("cannot write '" + json_path + "'");
+    f << out.dump(2) << "\n";
+    if (!svg_path.empty()) {
+      std::ofstream(svg_path) << bench::matchSweepSvg(rows, frame);
+      if (!global.quiet) fmt::print("wrote {} and {}\n", json_path, svg_path);
+    }
+  }
+  return kOk;
+}
+
+}  // namespace
+
 Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
   auto* bench = app.add_subcommand("bench", "Throughput benchmarks");
   bench->require_subcommand(1);
@@ -62,75 +146,7 @@ Runner addBenchCommand(CLI::App& app, const GlobalOptions& global) {
     if (train_command->parsed()) return train();
     if (detect_command->parsed()) return detect();
     if (soak_command->parsed()) return static_cast<int>(kOk);  // it ran (and passed) inside parse()
-    if (options->rgb.empty() != options->depth.empty()) throw InputError("--rgb and --depth go together");
-    if (!json_path->empty() && std::ifstream(*json_path).good())
-      throw InputError("'" + *json_path + "' exists; vkpose does not overwrite results (remove it first)");
-    std::string svg_path;
-    if (!sweep->empty()) {
-      if (json_path->empty()) throw InputError("--sweep writes its JSON and an SVG plot next to it: give --json FILE");
-      svg_path = std::filesystem::path(*json_path).replace_extension(".svg").string();
-      if (std::filesystem::exists(svg_path))
-        throw InputError("'" + svg_path + "' exists; vkpose does not overwrite results (remove it first)");
-      if (*sweep == "templates") {
-        options->sweep = bench::MatchSweep::Templates;
-        if (templates_option->count() == 0) options->template_counts = bench::templateSweepCounts();
-      } else {
-        options->sweep = bench::MatchSweep::Objects;
-      }
-    } else if (!options->bank.empty()) {
-      throw InputError("--bank is for --sweep objects");
-    }
-    options->progress = !global.quiet && isatty(STDERR_FILENO);
-    std::string frame;
-    const auto rows = bench::runMatchBenchmark(*options, global.gpu(), frame);
-    fmt::print("LINEMOD matching, both modalities, T = {{5, 8}}, threshold {} %, median of {} runs\n",
-               options->threshold, options->repeats);
-    fmt::print("frame: {}\n\n", frame);
-    fmt::print("device: {}\n\n", rows.empty() ? "" : rows.front().device);
-    fmt::print("{:>7}  {:>9}  {:>11}  {:>11}  {:>6}  {:>9}  {:>9}  {:>6}  {:>10}  {:>10}  {:>10}\n", "objects",
-               "templates", "vkpose ms", "opencv ms", "ratio", "matches", "opencv", "passes", "GPU peak", "RSS",
-               "peak RSS");
-    nlohmann::json out = nlohmann::json::array();
-    for (const auto& r : rows) {
-      fmt::print("{:>7}  {:>9}  {:>11.1f}  {:>11}  {:>6}  {:>9}  {:>9}  {:>6}  {:>10}  {:>10}  {:>10}\n",
-                 r.objects > 0 ? std::to_string(r.objects) : "-", r.templates, r.vkpose_ms,
-                 r.opencv_ms > 0 ? fmt::format("{:.1f}", r.opencv_ms) : "-",
-                 r.opencv_ms > 0 ? fmt::format("{:.2f}", r.ratio) : "-", r.vkpose_matches,
-                 r.opencv_ms > 0 ? std::to_string(r.opencv_matches) : "-",
-                 r.attempts > r.passes ? fmt::format("{}/{}", r.passes, r.attempts) : std::to_string(r.passes),
-                 bench::formatBytes(r.gpu_peak_bytes), bench::formatBytes(r.rss_bytes),
-                 bench::formatBytes(r.peak_rss_bytes));
-      nlohmann::json row = {{"templates", r.templates},
-                            {"device", r.device},
-                            {"vkpose_ms", r.vkpose_ms},
-                            {"vkpose_matches", r.vkpose_matches},
-                            {"passes", r.passes},
-                            {"attempts", r.attempts},
-                            {"coarse_candidates", r.coarse_candidates},
-                            {"gpu_peak_bytes", r.gpu_peak_bytes},
-                            {"rss_bytes", r.rss_bytes},
-                            {"peak_rss_bytes", r.peak_rss_bytes}};
-      if (r.objects > 0) row["objects"] = r.objects;
-      if (r.opencv_ms > 0) {
-        row["opencv_ms"] = r.opencv_ms;
-        row["ratio"] = r.ratio;
-        row["opencv_matches"] = r.opencv_matches;
-      }
-      out.push_back(row);
-    }
-    fmt::print("(passes: similarity passes, /submits when some overflowed and ran again; GPU peak: our GPU buffers at "
-               "most at once; RSS: resident after vkpose's runs; peak RSS: the process so far)\n");
-    bench::printKernelProfile();
-    if (!json_path->empty()) {
-      std::ofstream f(*json_path);
-      if (!f) throw InputError("cannot write '" + *json_path + "'");
-      f << out.dump(2) << "\n";
-      if (!svg_path.empty()) {
-        std::ofstream(svg_path) << bench::matchSweepSvg(rows, frame);
-        if (!global.quiet) fmt::print("wrote {} and {}\n", *json_path, svg_path);
-      }
-    }
-    return 0;
+    return static_cast<int>(runBenchMatch(*options, *json_path, *sweep, templates_option->count() > 0, global));
   };
 }
 

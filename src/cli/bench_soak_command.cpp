@@ -72,6 +72,45 @@ std::string difference(const DetectionResult& a, const DetectionResult& b) {
   return {};
 }
 
+/// --bank, or a small bank of the IC-BIN cup trained for the soak (--views viewpoints).
+TemplateBank soakBank(GpuContext& ctx, const SoakOptions& o, const Camera& camera, const std::string& data) {
+  if (!o.bank.empty()) return loadBank(o.bank);
+  TrainingParams params;
+  params.camera = camera;
+  params.symmetric = true;
+  params.views.viewpoints = o.views;
+  params.views.radii = {0.6f, 1.0f, 0.2f};
+  params.views.inplane_deg = {-20.f, 20.f, 10.f};
+  return trainTemplates(ctx, loadMesh(data + "/meshes/coffee_cup.stl"), params);
+}
+
+/// The soak's last lines; throws when memory grew past the bound or the detections changed.
+void reportSoak(const SoakOptions& o, double start, double peak, double total_s, const std::string& nondeterministic,
+                int differing) {
+  const double end = residentMiB();
+  const double growth = end - start;
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer holds freed memory in quarantine and maps shadow memory as it goes: the
+  // resident size swings by a gigabyte from frame to frame and says nothing about leaks, which
+  // LeakSanitizer reports at exit instead. The bound is printed, not enforced.
+  constexpr bool kEnforceBound = false;
+  const char* bound_note = ", not enforced under AddressSanitizer";
+#else
+  constexpr bool kEnforceBound = true;
+  const char* bound_note = "";
+#endif
+  fmt::print("end: VmRSS {:.1f} MiB, growth {:+.1f} MiB (bound {:.0f} MiB{}), peak {:.1f} MiB; {} frames in {:.1f} s "
+             "({:.0f} ms a frame)\n",
+             end, growth, o.max_growth_mib, bound_note, peak, o.frames, total_s, 1000.0 * total_s / o.frames);
+  fmt::print("deterministic: {}\n",
+             nondeterministic.empty() ? "yes" : fmt::format("no ({} of {} frames differ; first: {})", differing,
+                                                            o.frames, nondeterministic));
+  if (kEnforceBound && growth > o.max_growth_mib)
+    throw std::runtime_error(fmt::format("soak failed: resident memory grew by {:.1f} MiB over {} frames (bound {} MiB)",
+                                         growth, o.frames, o.max_growth_mib));
+  if (!nondeterministic.empty()) throw std::runtime_error("soak failed: the detections differ between runs");
+}
+
 void runSoak(const SoakOptions& o, const GlobalOptions& global) {
   const std::string data = VKPOSE_SHARED_DATA_DIR;
   const std::string icbin = data + "/icbin/";
@@ -88,18 +127,7 @@ void runSoak(const SoakOptions& o, const GlobalOptions& global) {
   const LinemodFrame frame = loadFrame(rgb, depth, camera.depth_scale);
 
   GpuContext ctx(global.gpu());
-  TemplateBank bank;
-  if (!o.bank.empty()) {
-    bank = loadBank(o.bank);
-  } else {
-    TrainingParams params;
-    params.camera = camera;
-    params.symmetric = true;
-    params.views.viewpoints = o.views;
-    params.views.radii = {0.6f, 1.0f, 0.2f};
-    params.views.inplane_deg = {-20.f, 20.f, 10.f};
-    bank = trainTemplates(ctx, loadMesh(data + "/meshes/coffee_cup.stl"), params);
-  }
+  TemplateBank bank = soakBank(ctx, o, camera, data);
   const std::string object = bank.object;
   const std::size_t templates = bank.templates.size();
   std::vector<TemplateBank> banks;
@@ -139,28 +167,7 @@ void runSoak(const SoakOptions& o, const GlobalOptions& global) {
     }
   }
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double end = residentMiB();
-  const double growth = end - start;
-#if defined(__SANITIZE_ADDRESS__)
-  // AddressSanitizer holds freed memory in quarantine and maps shadow memory as it goes: the
-  // resident size swings by a gigabyte from frame to frame and says nothing about leaks, which
-  // LeakSanitizer reports at exit instead. The bound is printed, not enforced.
-  constexpr bool kEnforceBound = false;
-  const char* bound_note = ", not enforced under AddressSanitizer";
-#else
-  constexpr bool kEnforceBound = true;
-  const char* bound_note = "";
-#endif
-  fmt::print("end: VmRSS {:.1f} MiB, growth {:+.1f} MiB (bound {:.0f} MiB{}), peak {:.1f} MiB; {} frames in {:.1f} s "
-             "({:.0f} ms a frame)\n",
-             end, growth, o.max_growth_mib, bound_note, peak, o.frames, total_s, 1000.0 * total_s / o.frames);
-  fmt::print("deterministic: {}\n",
-             nondeterministic.empty() ? "yes" : fmt::format("no ({} of {} frames differ; first: {})", differing,
-                                                            o.frames, nondeterministic));
-  if (kEnforceBound && growth > o.max_growth_mib)
-    throw std::runtime_error(fmt::format("soak failed: resident memory grew by {:.1f} MiB over {} frames (bound {} MiB)",
-                                         growth, o.frames, o.max_growth_mib));
-  if (!nondeterministic.empty()) throw std::runtime_error("soak failed: the detections differ between runs");
+  reportSoak(o, start, peak, total_s, nondeterministic, differing);
 }
 
 }  // namespace

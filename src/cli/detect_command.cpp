@@ -232,53 +232,71 @@ ExitCode runSequence(const DetectOptions& opt, const DetectorParams& params, con
   return failed > 0 ? kBadInput : kOk;
 }
 
-}  // namespace
+/// `vkpose detect` of one frame (or, with --frames or --list, a sequence: runSequence).
+ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
+  DetectorParams params = withConfig(opt.config, opt.params);
+  if (!opt.sensor.empty()) params.sensor = sensorProfile(opt.sensor);
+  if (!opt.frames.empty() || !opt.list.empty()) return runSequence(opt, params, global);
+  for (const std::string* path : {&opt.out, &opt.overlay})
+    if (!path->empty()) checkWritable(*path, opt.force);
+  Camera camera = loadCamera(opt.camera, opt.camera_entry);
+  if (opt.depth_scale > 0) camera.depth_scale = opt.depth_scale;
+  const LinemodFrame frame = loadFrame(opt.rgb, opt.depth, camera.depth_scale);
 
-Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
-  auto opt = std::make_shared<DetectOptions>();
-  auto& p = opt->params;
-  auto* sub = app.add_subcommand("detect", "Find the objects of one or more template banks in an RGB-D frame");
-  sub->add_option("--bank", opt->banks, "Template bank (.vkpb) of an object; repeat for several objects")
-      ->required();  // a missing bank is bad input (exit 1, loadBank names it), not a usage error
-  // The input: one frame (--rgb with --depth) or a sequence (--frames or --list), exactly one.
-  auto* input = sub->add_option_group("Input", "One frame (--rgb and --depth) or a sequence (--frames or --list)");
-  auto* rgb = input->add_option("--rgb", opt->rgb, "Colour image (PNG/JPEG, 8-bit)");
-  auto* frames = input->add_option("--frames", opt->frames,
-                                   "Folder of a frame sequence: rgb/ and depth/ with the same file names (a BOP scene "
-                                   "folder; cameras from its scene_camera.json unless --camera is given)");
-  auto* list = input->add_option("--list", opt->list,
-                                 "Text file of a frame sequence: a colour and a depth image path per line");
-  input->require_option(1);
-  auto* depth = sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)");
-  rgb->needs(depth);
-  depth->needs(rgb);
-  depth->excludes(frames)->excludes(list);
-  auto* camera_opt = sub->add_option("--camera", opt->camera,
-                                     "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json (required "
-                                     "but with --frames of a folder that has a scene_camera.json)");
-  rgb->needs(camera_opt);
-  list->needs(camera_opt);
-  sub->add_option("--camera-entry", opt->camera_entry, "Key of the scene_camera.json entry (default: the first)");
-  sub->add_option("--depth-scale", opt->depth_scale,
-                  "Millimetres per depth-PNG unit (default: the camera file's depth_scale, else 1)")
-      ->check(CLI::PositiveNumber);
-  // One frame's outputs; a sequence writes to --out-dir or --jsonl.
-  sub->add_option("--out", opt->out, "Detection JSON to write")->excludes(frames)->excludes(list);
-  sub->add_option("--overlay", opt->overlay,
-                  "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)")
-      ->excludes(frames)
-      ->excludes(list);
-  sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
-                "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
-  sub->add_flag("--side-by-side", opt->side_by_side,
-                "Put the depth image (false colour, with the same drawing) to the right of the colour overlay");
-  auto* out_dir = sub->add_option(
-      "--out-dir", opt->out_dir, "Sequences: folder for one detection JSON per frame (NAME.json, NAME the colour image's stem)");
-  sub->add_option("--jsonl", opt->jsonl, "Sequences: one JSON Lines file, a frame's detection JSON per line");
-  sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir")->needs(out_dir);
-  sub->add_flag("--force", opt->force, "Overwrite output files that exist");
-  addConfigOption(sub, opt->config);
-  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  std::vector<TemplateBank> banks = loadBanks(opt.banks, global.quiet);
+  GpuContext ctx(global.gpu());
+  Detector detector(ctx, std::move(banks), params);
+  const DetectionResult result = detector.detect(frame, camera);
+  for (const auto& w : result.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
+
+  fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
+             result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
+             result.scored_hypotheses,
+             params.estimate_poses ? params.pose_min_score : params.min_score, ctx.device().name);
+  if (global.verbose && result.match_pairs > 0)
+    fmt::print("depth-guided pruning: {:.1f} % of {} (template, position) pairs pruned, {:.1f} % skipped unread\n",
+               100.0 * static_cast<double>(result.match_pairs_pruned) / static_cast<double>(result.match_pairs),
+               result.match_pairs,
+               100.0 * static_cast<double>(result.match_pairs_skipped) / static_cast<double>(result.match_pairs));
+  if (global.verbose && params.estimate_poses) printScaledLengths(detector.banks(), params);
+  if (!result.rejected.empty())
+    fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
+               result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");
+  auto table = [](const std::vector<Detection>& dets, bool reasons) {
+    fmt::print("  {:>3}  {:<16} {:>6} {:>6} {:>6}  {:>20}  {:>24}  {}\n", "#", "object", "score", "gamma", "phi",
+               "box x,y,w,h (px)", "t (m)", reasons ? "why rejected" : "icp fitness (mm^2)");
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      const Detection& d = dets[i];
+      fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6}  {:>20}  {:>24}  {}\n", i + 1, d.object, d.score, d.gamma,
+                 d.collision_rate >= 0.f ? fmt::format("{:.3f}", d.collision_rate) : "-",
+                 fmt::format("{:.0f},{:.0f},{:.0f},{:.0f}", d.bbox.x, d.bbox.y, d.bbox.width, d.bbox.height),
+                 fmt::format("{:.3f},{:.3f},{:.3f}", d.pose.t.x(), d.pose.t.y(), d.pose.t.z()),
+                 reasons ? d.rejection : (d.collision_rate >= 0.f ? fmt::format("{:.2f}", d.icp_fitness * 1e6) : "-"));
+    }
+  };
+  if (!result.detections.empty()) table(result.detections, false);
+  if (global.verbose && !result.rejected.empty()) table(result.rejected, true);
+  if (!global.quiet) {
+    fmt::print("timings (ms):");
+    for (const auto& [stage, ms] : result.timings_ms) fmt::print(" {} {:.1f}", stage, ms);
+    fmt::print("\n");
+  }
+  if (!opt.out.empty()) {
+    writeTextFile(opt.out, detectionJson(result, {opt.rgb, opt.depth, ctx.device().name}), opt.force);
+    if (!global.quiet) fmt::print("wrote {}\n", opt.out);
+  }
+  if (!opt.overlay.empty()) {
+    OverlayOptions overlay = opt.overlay_options;
+    if (opt.side_by_side) overlay.depth_mm = frame.depth_mm;
+    writeImage(opt.overlay, drawDetections(frame.bgr, result, detector.banks(), withFrameSize(camera, frame), overlay),
+               opt.force);
+    if (!global.quiet) fmt::print("wrote {}\n", opt.overlay);
+  }
+  return kOk;
+}
+
+/// The stage parameters `detect` takes as flags (a --config file sets every one).
+void addStageFlags(CLI::App* sub, DetectorParams& p) {
   auto* stages = "Stage parameters";
   sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
       ->check(CLI::Range(1.0, 100.0))
@@ -343,67 +361,56 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str()
       ->group(stages);
-  return [opt, &global]() {
-    DetectorParams params = withConfig(opt->config, opt->params);
-    if (!opt->sensor.empty()) params.sensor = sensorProfile(opt->sensor);
-    if (!opt->frames.empty() || !opt->list.empty()) return runSequence(*opt, params, global);
-    for (const std::string* path : {&opt->out, &opt->overlay})
-      if (!path->empty()) checkWritable(*path, opt->force);
-    Camera camera = loadCamera(opt->camera, opt->camera_entry);
-    if (opt->depth_scale > 0) camera.depth_scale = opt->depth_scale;
-    const LinemodFrame frame = loadFrame(opt->rgb, opt->depth, camera.depth_scale);
+}
+}  // namespace
 
-    std::vector<TemplateBank> banks = loadBanks(opt->banks, global.quiet);
-    GpuContext ctx(global.gpu());
-    Detector detector(ctx, std::move(banks), params);
-    const DetectionResult result = detector.detect(frame, camera);
-    for (const auto& w : result.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
-
-    fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
-               result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
-               result.scored_hypotheses,
-               params.estimate_poses ? params.pose_min_score : params.min_score, ctx.device().name);
-    if (global.verbose && result.match_pairs > 0)
-      fmt::print("depth-guided pruning: {:.1f} % of {} (template, position) pairs pruned, {:.1f} % skipped unread\n",
-                 100.0 * static_cast<double>(result.match_pairs_pruned) / static_cast<double>(result.match_pairs),
-                 result.match_pairs,
-                 100.0 * static_cast<double>(result.match_pairs_skipped) / static_cast<double>(result.match_pairs));
-    if (global.verbose && params.estimate_poses) printScaledLengths(detector.banks(), params);
-    if (!result.rejected.empty())
-      fmt::print("{} hypothes{} rejected by pose verification{}\n", result.rejected.size(),
-                 result.rejected.size() == 1 ? "is" : "es", global.verbose ? ":" : " (--verbose lists them)");
-    auto table = [](const std::vector<Detection>& dets, bool reasons) {
-      fmt::print("  {:>3}  {:<16} {:>6} {:>6} {:>6}  {:>20}  {:>24}  {}\n", "#", "object", "score", "gamma", "phi",
-                 "box x,y,w,h (px)", "t (m)", reasons ? "why rejected" : "icp fitness (mm^2)");
-      for (std::size_t i = 0; i < dets.size(); ++i) {
-        const Detection& d = dets[i];
-        fmt::print("  {:>3}  {:<16} {:>6.3f} {:>6.3f} {:>6}  {:>20}  {:>24}  {}\n", i + 1, d.object, d.score, d.gamma,
-                   d.collision_rate >= 0.f ? fmt::format("{:.3f}", d.collision_rate) : "-",
-                   fmt::format("{:.0f},{:.0f},{:.0f},{:.0f}", d.bbox.x, d.bbox.y, d.bbox.width, d.bbox.height),
-                   fmt::format("{:.3f},{:.3f},{:.3f}", d.pose.t.x(), d.pose.t.y(), d.pose.t.z()),
-                   reasons ? d.rejection : (d.collision_rate >= 0.f ? fmt::format("{:.2f}", d.icp_fitness * 1e6) : "-"));
-      }
-    };
-    if (!result.detections.empty()) table(result.detections, false);
-    if (global.verbose && !result.rejected.empty()) table(result.rejected, true);
-    if (!global.quiet) {
-      fmt::print("timings (ms):");
-      for (const auto& [stage, ms] : result.timings_ms) fmt::print(" {} {:.1f}", stage, ms);
-      fmt::print("\n");
-    }
-    if (!opt->out.empty()) {
-      writeTextFile(opt->out, detectionJson(result, {opt->rgb, opt->depth, ctx.device().name}), opt->force);
-      if (!global.quiet) fmt::print("wrote {}\n", opt->out);
-    }
-    if (!opt->overlay.empty()) {
-      OverlayOptions overlay = opt->overlay_options;
-      if (opt->side_by_side) overlay.depth_mm = frame.depth_mm;
-      writeImage(opt->overlay, drawDetections(frame.bgr, result, detector.banks(), withFrameSize(camera, frame), overlay),
-                 opt->force);
-      if (!global.quiet) fmt::print("wrote {}\n", opt->overlay);
-    }
-    return kOk;
-  };
+Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<DetectOptions>();
+  auto& p = opt->params;
+  auto* sub = app.add_subcommand("detect", "Find the objects of one or more template banks in an RGB-D frame");
+  sub->add_option("--bank", opt->banks, "Template bank (.vkpb) of an object; repeat for several objects")
+      ->required();  // a missing bank is bad input (exit 1, loadBank names it), not a usage error
+  // The input: one frame (--rgb with --depth) or a sequence (--frames or --list), exactly one.
+  auto* input = sub->add_option_group("Input", "One frame (--rgb and --depth) or a sequence (--frames or --list)");
+  auto* rgb = input->add_option("--rgb", opt->rgb, "Colour image (PNG/JPEG, 8-bit)");
+  auto* frames = input->add_option("--frames", opt->frames,
+                                   "Folder of a frame sequence: rgb/ and depth/ with the same file names (a BOP scene "
+                                   "folder; cameras from its scene_camera.json unless --camera is given)");
+  auto* list = input->add_option("--list", opt->list,
+                                 "Text file of a frame sequence: a colour and a depth image path per line");
+  input->require_option(1);
+  auto* depth = sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)");
+  rgb->needs(depth);
+  depth->needs(rgb);
+  depth->excludes(frames)->excludes(list);
+  auto* camera_opt = sub->add_option("--camera", opt->camera,
+                                     "BOP camera.json (cam_K or fx/fy/cx/cy, depth_scale) or scene_camera.json (required "
+                                     "but with --frames of a folder that has a scene_camera.json)");
+  rgb->needs(camera_opt);
+  list->needs(camera_opt);
+  sub->add_option("--camera-entry", opt->camera_entry, "Key of the scene_camera.json entry (default: the first)");
+  sub->add_option("--depth-scale", opt->depth_scale,
+                  "Millimetres per depth-PNG unit (default: the camera file's depth_scale, else 1)")
+      ->check(CLI::PositiveNumber);
+  // One frame's outputs; a sequence writes to --out-dir or --jsonl.
+  sub->add_option("--out", opt->out, "Detection JSON to write")->excludes(frames)->excludes(list);
+  sub->add_option("--overlay", opt->overlay,
+                  "Overlay PNG to write (model outlines and axes of the poses, labels, scores, legend)")
+      ->excludes(frames)
+      ->excludes(list);
+  sub->add_flag("--show-rejected", opt->overlay_options.show_rejected,
+                "Also draw the hypotheses that pose verification rejected (in red) on the overlay");
+  sub->add_flag("--side-by-side", opt->side_by_side,
+                "Put the depth image (false colour, with the same drawing) to the right of the colour overlay");
+  auto* out_dir = sub->add_option(
+      "--out-dir", opt->out_dir, "Sequences: folder for one detection JSON per frame (NAME.json, NAME the colour image's stem)");
+  sub->add_option("--jsonl", opt->jsonl, "Sequences: one JSON Lines file, a frame's detection JSON per line");
+  sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir")->needs(out_dir);
+  sub->add_flag("--force", opt->force, "Overwrite output files that exist");
+  addConfigOption(sub, opt->config);
+  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  addStageFlags(sub, p);
+  return [opt, &global]() { return runDetect(*opt, global); };
 }
 
 }  // namespace vkpose::cli

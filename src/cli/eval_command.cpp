@@ -45,6 +45,91 @@ std::map<int, std::string> parseBankArgs(const std::vector<std::string>& args) {
   }
   return out;
 }
+
+/// Nothing is computed before every output is known to be writable.
+void checkOutputs(const EvalOptions& opt, const std::vector<EvalMethod>& methods) {
+  std::vector<std::string> outputs;
+  if (!opt.report.empty()) outputs.push_back(opt.report);
+  if (!opt.pr_curve.empty()) outputs.push_back(opt.pr_curve);
+  if (!opt.out.empty())
+    for (EvalMethod m : methods) outputs.push_back(methodResultsPath(opt.out, m));
+  for (const auto& path : outputs) {
+    if (!opt.force && std::filesystem::exists(path))
+      throw InputError(path + " exists: pass --force to overwrite it");
+    const auto folder = std::filesystem::path(path).parent_path();
+    if (!folder.empty() && !std::filesystem::is_directory(folder))
+      throw InputError(fmt::format("{}: no such folder to write {} into", folder.string(), path));
+  }
+}
+
+/// Per method: precision and recall at score 0.5, and the best F1 with its threshold.
+void printPrSummary(const EvalReport& report) {
+  for (const MethodEvaluation& m : report.methods) {
+    const auto curve = precisionRecallCurve(m.outcomes, m.summary.total.tp + m.summary.total.fn);
+    const PrPoint* at_half = nullptr;
+    const PrPoint* best = nullptr;
+    for (const PrPoint& pt : curve) {
+      if (pt.threshold >= 0.5f) at_half = &pt;
+      if (!best || pt.scores.f1 > best->scores.f1) best = &pt;
+    }
+    if (!best) continue;
+    fmt::print("{}: {}best F1 {:.3f} at score >= {:.3g}\n", methodName(m.method),
+               at_half ? fmt::format("score >= 0.5: precision {:.3f}, recall {:.3f}; ", at_half->scores.precision,
+                                     at_half->scores.recall)
+                       : std::string("no estimate scores 0.5; "),
+               best->scores.f1, best->threshold);
+  }
+}
+
+/// `vkpose eval`.
+ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
+  EvalRunParams params = opt.params;
+  params.detector = withConfig(opt.config, params.detector);
+  if (!opt.sensor.empty()) params.detector.sensor = sensorProfile(opt.sensor);
+  params.linemod.match = params.detector.match;
+  if (!opt.methods.empty()) {
+    params.methods.clear();
+    for (const auto& m : opt.methods) params.methods.push_back(parseEvalMethod(m));
+  }
+  checkOutputs(opt, params.methods);
+  if (!std::filesystem::is_directory(opt.dataset))
+    throw InputError(opt.dataset + ": no such dataset folder");
+
+  const BopDataset dataset = loadBopDataset(opt.dataset, opt.split);
+  std::map<int, TemplateBank> banks;
+  for (const auto& [obj_id, path] : parseBankArgs(opt.banks)) banks.emplace(obj_id, loadBank(path));
+  checkBanksAgainstDataset(banks, dataset);
+
+  GpuContext ctx(global.gpu());
+  ProgressBar bar("evaluating", global.quiet);
+  const EvalReport report =
+      runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
+  bar.finish();
+  for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
+
+  fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
+             report.images == 1 ? "" : "s", report.dataset, report.split, report.objects.size(),
+             report.objects.size() == 1 ? "" : "s", params.eval.k_m, report.device);
+  fmt::print("{}", evalReportTable(report));
+  if (!opt.report.empty()) {
+    writeTextFile(opt.report, evalReportJson(report), opt.force);
+    if (!global.quiet) fmt::print("wrote {}\n", opt.report);
+  }
+  if (!opt.pr_curve.empty()) {
+    const bool svg = std::filesystem::path(opt.pr_curve).extension() == ".svg";
+    writeTextFile(opt.pr_curve, svg ? precisionRecallSvg(report) : precisionRecallCsv(report), opt.force);
+    printPrSummary(report);
+    if (!global.quiet) fmt::print("wrote {}\n", opt.pr_curve);
+  }
+  if (!opt.out.empty())
+    for (const MethodEvaluation& m : report.methods) {
+      const std::string path = methodResultsPath(opt.out, m.method);
+      saveBopResults(path, m.results);
+      if (!global.quiet) fmt::print("wrote {} ({} estimates)\n", path, m.results.size());
+    }
+  return kOk;
+}
+
 }  // namespace
 
 Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
@@ -105,79 +190,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.02, 1.0))
       ->capture_default_str()
       ->group(methods);
-  return [opt, &global]() {
-    EvalRunParams params = opt->params;
-    params.detector = withConfig(opt->config, params.detector);
-    if (!opt->sensor.empty()) params.detector.sensor = sensorProfile(opt->sensor);
-    params.linemod.match = params.detector.match;
-    if (!opt->methods.empty()) {
-      params.methods.clear();
-      for (const auto& m : opt->methods) params.methods.push_back(parseEvalMethod(m));
-    }
-    // Nothing is computed before every output is known to be writable.
-    std::vector<std::string> outputs;
-    if (!opt->report.empty()) outputs.push_back(opt->report);
-    if (!opt->pr_curve.empty()) outputs.push_back(opt->pr_curve);
-    if (!opt->out.empty())
-      for (EvalMethod m : params.methods) outputs.push_back(methodResultsPath(opt->out, m));
-    for (const auto& path : outputs) {
-      if (!opt->force && std::filesystem::exists(path))
-        throw InputError(path + " exists: pass --force to overwrite it");
-      const auto folder = std::filesystem::path(path).parent_path();
-      if (!folder.empty() && !std::filesystem::is_directory(folder))
-        throw InputError(fmt::format("{}: no such folder to write {} into", folder.string(), path));
-    }
-    if (!std::filesystem::is_directory(opt->dataset))
-      throw InputError(opt->dataset + ": no such dataset folder");
-
-    const BopDataset dataset = loadBopDataset(opt->dataset, opt->split);
-    std::map<int, TemplateBank> banks;
-    for (const auto& [obj_id, path] : parseBankArgs(opt->banks)) banks.emplace(obj_id, loadBank(path));
-    checkBanksAgainstDataset(banks, dataset);
-
-    GpuContext ctx(global.gpu());
-    ProgressBar bar("evaluating", global.quiet);
-    const EvalReport report =
-        runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
-    bar.finish();
-    for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
-
-    fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
-               report.images == 1 ? "" : "s", report.dataset, report.split, report.objects.size(),
-               report.objects.size() == 1 ? "" : "s", params.eval.k_m, report.device);
-    fmt::print("{}", evalReportTable(report));
-    if (!opt->report.empty()) {
-      writeTextFile(opt->report, evalReportJson(report), opt->force);
-      if (!global.quiet) fmt::print("wrote {}\n", opt->report);
-    }
-    if (!opt->pr_curve.empty()) {
-      const bool svg = std::filesystem::path(opt->pr_curve).extension() == ".svg";
-      writeTextFile(opt->pr_curve, svg ? precisionRecallSvg(report) : precisionRecallCsv(report), opt->force);
-      for (const MethodEvaluation& m : report.methods) {
-        const auto curve = precisionRecallCurve(m.outcomes, m.summary.total.tp + m.summary.total.fn);
-        const PrPoint* at_half = nullptr;
-        const PrPoint* best = nullptr;
-        for (const PrPoint& pt : curve) {
-          if (pt.threshold >= 0.5f) at_half = &pt;
-          if (!best || pt.scores.f1 > best->scores.f1) best = &pt;
-        }
-        if (!best) continue;
-        fmt::print("{}: {}best F1 {:.3f} at score >= {:.3g}\n", methodName(m.method),
-                   at_half ? fmt::format("score >= 0.5: precision {:.3f}, recall {:.3f}; ", at_half->scores.precision,
-                                         at_half->scores.recall)
-                           : std::string("no estimate scores 0.5; "),
-                   best->scores.f1, best->threshold);
-      }
-      if (!global.quiet) fmt::print("wrote {}\n", opt->pr_curve);
-    }
-    if (!opt->out.empty())
-      for (const MethodEvaluation& m : report.methods) {
-        const std::string path = methodResultsPath(opt->out, m.method);
-        saveBopResults(path, m.results);
-        if (!global.quiet) fmt::print("wrote {} ({} estimates)\n", path, m.results.size());
-      }
-    return kOk;
-  };
+  return [opt, &global]() { return runEval(*opt, global); };
 }
 
 }  // namespace vkpose::cli

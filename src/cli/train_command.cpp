@@ -41,6 +41,70 @@ TrainingParams trainingParamsFrom(const TrainOptions& o) {
   validateTrainingParams(p);
   return p;
 }
+/// What training chose: the up axis (and, with -v, why) and the other resting poses.
+void printPlan(const TrainingPlan& plan, const TrainingParams& params, const Mesh& mesh, const TrainOptions& opt,
+               bool verbose) {
+  if (opt.up == "auto") {
+    fmt::print("up axis: {} (auto: {})\n", upAxisName(params.views.up), plan.found.reason);
+    if (verbose)
+      for (const RestingCandidate& c : plan.found.candidates)
+        fmt::print("  {} up: base {:.0f}% of the footprint, {:.0f} degrees off the axis, centre of mass {:.1f} mm "
+                   "inside it{}\n",
+                   upAxisName(c.up), 100.f * c.support, c.tilt_deg, 1e3f * c.margin_m, c.stands() ? ", stands" : "");
+  } else {
+    fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
+  }
+  if (!params.views.full_sphere) {
+    const bool trained = !params.views.other_ups.empty();
+    fmt::print("other resting poses: {} ({})\n", restingUpsText(plan.other_ups),
+               plan.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
+               : trained && opt.resting == "auto"
+                   ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
+                                 "in a bin; --resting up trains it standing only",
+                                 1e3f * mesh.diameter)
+               : trained ? "a hemisphere of views about each as well"
+                     : "not trained: pass --resting all to find it lying down too");
+  }
+}
+
+/// `vkpose train`.
+ExitCode runTrain(const TrainOptions& opt, const GlobalOptions& global) {
+  TrainingParams params = trainingParamsFrom(opt);
+  if (std::filesystem::exists(opt.out) && !opt.force)
+    throw InputError(fmt::format("{} exists: pass --force to overwrite it", opt.out));
+  MeshLoadReport report;
+  const Mesh mesh = loadMesh(opt.mesh, parseMeshUnits(opt.units), &report);
+  if (!global.quiet) {
+    fmt::print("mesh: {} ({} triangles, {} vertices{}{})\n", mesh.name, mesh.faces.size(), mesh.vertices.size(),
+               mesh.colours.empty() ? "" : ", vertex colours", mesh.normals.empty() ? "" : ", normals");
+    if (report.inferred)
+      fmt::print("units: {} (inferred: the file's diameter is {:.4g} units; pass --units to override)\n",
+                 unitName(report.units), report.file_diameter);
+    fmt::print("diameter: {:.4f} m\n", mesh.diameter);
+  }
+  for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
+  const TrainingPlan plan = planTraining(mesh, params, opt.up == "auto", opt.resting, opt.max_view_angle);
+  printPlan(plan, params, mesh, opt, global.verbose);
+  GpuContext ctx(global.gpu());
+  ProgressBar bar("training", global.quiet);
+  TrainingTimings timings;
+  const TemplateBank bank = trainTemplatesFromViews(
+      ctx, mesh, params, plan.views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);
+  bar.finish();
+  saveBank(bank, opt.out);
+  const auto bytes = std::filesystem::file_size(opt.out);
+  fmt::print("templates: {}\n", bank.templates.size());
+  printNearSymmetries(bank);
+  if (!global.quiet) {
+    if (timings.dropped) fmt::print("dropped: {} views with too few features\n", timings.dropped);
+    fmt::print("time: {:.1f} s (render {:.1f} s, features {:.1f} s) on {}, {:.0f} templates/s\n",
+               timings.total_ms / 1e3, timings.render_ms / 1e3, timings.features_ms / 1e3, ctx.device().name,
+               1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
+    fmt::print("bank: {} ({:.1f} MiB)\n", opt.out, static_cast<double>(bytes) / (1 << 20));
+  }
+  bench::printKernelProfile();
+  return kOk;
+}
 }  // namespace
 
 Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
@@ -87,63 +151,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 0.2))
       ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out if it exists");
-  return [opt, &global]() {
-    TrainingParams params = trainingParamsFrom(*opt);
-    if (std::filesystem::exists(opt->out) && !opt->force)
-      throw InputError(fmt::format("{} exists: pass --force to overwrite it", opt->out));
-    MeshLoadReport report;
-    const Mesh mesh = loadMesh(opt->mesh, parseMeshUnits(opt->units), &report);
-    if (!global.quiet) {
-      fmt::print("mesh: {} ({} triangles, {} vertices{}{})\n", mesh.name, mesh.faces.size(), mesh.vertices.size(),
-                 mesh.colours.empty() ? "" : ", vertex colours", mesh.normals.empty() ? "" : ", normals");
-      if (report.inferred)
-        fmt::print("units: {} (inferred: the file's diameter is {:.4g} units; pass --units to override)\n",
-                   unitName(report.units), report.file_diameter);
-      fmt::print("diameter: {:.4f} m\n", mesh.diameter);
-    }
-    for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
-    const TrainingPlan plan = planTraining(mesh, params, opt->up == "auto", opt->resting, opt->max_view_angle);
-    if (opt->up == "auto") {
-      fmt::print("up axis: {} (auto: {})\n", upAxisName(params.views.up), plan.found.reason);
-      if (global.verbose)
-        for (const RestingCandidate& c : plan.found.candidates)
-          fmt::print("  {} up: base {:.0f}% of the footprint, {:.0f} degrees off the axis, centre of mass {:.1f} mm "
-                     "inside it{}\n",
-                     upAxisName(c.up), 100.f * c.support, c.tilt_deg, 1e3f * c.margin_m, c.stands() ? ", stands" : "");
-    } else {
-      fmt::print("up axis: {} (--up)\n", upAxisName(params.views.up));
-    }
-    if (!params.views.full_sphere) {
-      const bool trained = !params.views.other_ups.empty();
-      fmt::print("other resting poses: {} ({})\n", restingUpsText(plan.other_ups),
-                 plan.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
-                 : trained && opt->resting == "auto"
-                     ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
-                                   "in a bin; --resting up trains it standing only",
-                                   1e3f * mesh.diameter)
-                 : trained ? "a hemisphere of views about each as well"
-                       : "not trained: pass --resting all to find it lying down too");
-    }
-    GpuContext ctx(global.gpu());
-    ProgressBar bar("training", global.quiet);
-    TrainingTimings timings;
-    const TemplateBank bank = trainTemplatesFromViews(
-        ctx, mesh, params, plan.views, [&](std::size_t done, std::size_t total) { bar.update(done, total); }, &timings);
-    bar.finish();
-    saveBank(bank, opt->out);
-    const auto bytes = std::filesystem::file_size(opt->out);
-    fmt::print("templates: {}\n", bank.templates.size());
-    printNearSymmetries(bank);
-    if (!global.quiet) {
-      if (timings.dropped) fmt::print("dropped: {} views with too few features\n", timings.dropped);
-      fmt::print("time: {:.1f} s (render {:.1f} s, features {:.1f} s) on {}, {:.0f} templates/s\n",
-                 timings.total_ms / 1e3, timings.render_ms / 1e3, timings.features_ms / 1e3, ctx.device().name,
-                 1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
-      fmt::print("bank: {} ({:.1f} MiB)\n", opt->out, static_cast<double>(bytes) / (1 << 20));
-    }
-    bench::printKernelProfile();
-    return kOk;
-  };
+  return [opt, &global]() { return runTrain(*opt, global); };
 }
 
 }  // namespace vkpose::cli

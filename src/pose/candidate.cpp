@@ -13,6 +13,26 @@ namespace vkpose {
 
 using util::msSince;
 
+namespace {
+
+/// fn(c) for each candidate that stage 6 placed (initial.ok), on `threads` threads, each
+/// call's time added to the candidate's cpu_ms.
+template <class Fn>
+void forEachPlaced(std::vector<PoseCandidate>& candidates, unsigned threads, Fn&& fn) {
+  util::parallelFor(
+      candidates.size(),
+      [&](std::size_t i) {
+        PoseCandidate& c = candidates[i];
+        if (!c.initial.ok) return;
+        const auto start = std::chrono::steady_clock::now();
+        fn(c);
+        c.cpu_ms += msSince(start);
+      },
+      threads);
+}
+
+}  // namespace
+
 PoseFrame poseFrame(const Camera& camera, const cv::Mat& depth_m, const cv::Mat& bgr) {
   PoseFrame frame;
   frame.camera = camera;
@@ -108,34 +128,20 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
 }
 
 void smoothSceneCrops(std::vector<PoseCandidate>& candidates, unsigned threads) {
-  util::parallelFor(
-      candidates.size(),
-      [&](std::size_t i) {
-        PoseCandidate& c = candidates[i];
-        if (!c.initial.ok) return;
-        const auto start = std::chrono::steady_clock::now();
-        const RefineParams& rp = c.refine;
-        c.smoothed = rp.mls ? smoothMls(c.initial.scene_points, rp.mls_radius, rp.mls_polynomial_order,
-                                        rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f, rp.mls_max_neighbours)
-                            : c.initial.scene_points;
-        c.cpu_ms += msSince(start);
-      },
-      threads);
+  forEachPlaced(candidates, threads, [](PoseCandidate& c) {
+    const RefineParams& rp = c.refine;
+    c.smoothed = rp.mls ? smoothMls(c.initial.scene_points, rp.mls_radius, rp.mls_polynomial_order,
+                                    rp.mls_at_voxel_seeds ? rp.voxel_size : 0.f, rp.mls_max_neighbours)
+                        : c.initial.scene_points;
+  });
 }
 
 void refineCandidates(std::vector<PoseCandidate>& candidates, unsigned threads) {
-  util::parallelFor(
-      candidates.size(),
-      [&](std::size_t i) {
-        PoseCandidate& c = candidates[i];
-        if (!c.initial.ok) return;
-        const auto start = std::chrono::steady_clock::now();
-        RefineParams icp_params = c.refine;
-        icp_params.mls = false;  // smoothSceneCrops did it
-        c.refined = refinePose(c.initial.model_points, c.smoothed, c.initial.pose, icp_params);
-        c.cpu_ms += msSince(start);
-      },
-      threads);
+  forEachPlaced(candidates, threads, [](PoseCandidate& c) {
+    RefineParams icp_params = c.refine;
+    icp_params.mls = false;  // smoothSceneCrops did it
+    c.refined = refinePose(c.initial.model_points, c.smoothed, c.initial.pose, icp_params);
+  });
 }
 
 PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const PointCloud& scene_points,
