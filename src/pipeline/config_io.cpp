@@ -19,7 +19,10 @@ namespace vkpose {
 
 using nlohmann::json;
 
-std::vector<ConfigField> configFields(DetectorParams& p) {
+namespace {
+
+/// Stages 1-5 and the detector's own fields.
+std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
   return {
       {"match", "threshold", "LINEMOD similarity a match needs, percent", &p.match.threshold},
       {"match", "depth_pruning", "score templates only where the scene depth suits their distance", &p.match.depth_pruning},
@@ -51,6 +54,12 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"detector", "duplicate_fraction", "poses closer than this share of the diameter are one, 0..1",
        &p.duplicate_fraction},
       {"detector", "threads", "CPU threads for the pose stages (0: all cores)", &p.threads},
+  };
+}
+
+/// Stages 6 and 7.
+std::vector<ConfigField> poseFields(DetectorParams& p) {
+  return {
       {"initial_pose", "rotation_cluster_deg", "template rotations within this angle vote together, degrees",
        &p.initial_pose.rotation_cluster_deg},
       {"initial_pose", "second_start_by_fit",
@@ -89,6 +98,12 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"refine", "min_points", "fewer points after filtering: rejected", &p.refine.min_points},
       {"refine", "fixed_max_correspondence_m", "fixed ICP correspondence distance, metres (0: from the diameter)",
        &p.refine.fixed_max_correspondence_m},
+  };
+}
+
+/// Stage 8 and the sensor.
+std::vector<ConfigField> verifyFields(DetectorParams& p) {
+  return {
       {"verify", "resolution", "octree leaf size, metres", &p.verify.resolution},
       {"verify", "threshold", "collision rate phi a pose needs, 0..1", &p.verify.threshold},
       {"verify", "crop_margin", "scene points within the model's box grown by this go in the octree, metres",
@@ -133,6 +148,14 @@ std::vector<ConfigField> configFields(DetectorParams& p) {
       {"detector", "scale_lengths", "lengths left at their defaults follow each object's size and the sensor's noise",
        &p.scale_lengths},
   };
+}
+
+}  // namespace
+
+std::vector<ConfigField> configFields(DetectorParams& p) {
+  std::vector<ConfigField> fields = hypothesisFields(p);
+  for (auto part : {poseFields(p), verifyFields(p)}) fields.insert(fields.end(), part.begin(), part.end());
+  return fields;
 }
 
 namespace {

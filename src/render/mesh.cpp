@@ -151,6 +151,81 @@ std::size_t plyScalarBytes(std::string_view name) {
   return 0;
 }
 
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  uint64_t least = 0;       // bytes (binary) or values (ASCII) one instance takes at least
+  std::vector<bool> lists;  // per property: a list (a count, then that many values)?
+};
+
+/// A refused header line as the error message quotes it: its tokens, at most 60 characters.
+std::string quoted(const std::vector<std::string_view>& tokens) {
+  return fmt::format("{}", fmt::join(tokens, " ")).substr(0, 60);
+}
+
+/// An "element" or "property" line of a PLY header, added to `elements`; a malformed one is
+/// refused. Other lines are skipped, as assimp skips them.
+void readPlyDeclaration(const std::vector<std::string_view>& t, bool ascii, const std::string& path,
+                        std::vector<PlyElement>& elements) {
+  if (t[0] == "element") {
+    // A count assimp would read some other way (fuzz_mesh: digits run into the name, and
+    // no count) is refused rather than left to it: it allocated 23 GB for one.
+    PlyElement e;
+    bool counted = t.size() == 3;
+    if (counted) {
+      const char* end = t[2].data() + t[2].size();
+      const auto [ptr, ec] = std::from_chars(t[2].data(), end, e.count);
+      counted = ec == std::errc{} && ptr == end;
+    }
+    if (!counted)
+      throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path, quoted(t)));
+    e.name = std::string(t[1]);
+    elements.push_back(e);
+  } else if (t[0] == "property") {
+    // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
+    // count at least (it may be empty). Anything else is refused, as a malformed element
+    // line is: assimp read such a header its own way and then wild memory (fuzz_mesh).
+    const bool list = t.size() == 5 && t[1] == "list";
+    const std::size_t size = t.size() == 3 || list ? plyScalarBytes(list ? t[2] : t[1]) : 0;
+    if (elements.empty() || size == 0 || (list && plyScalarBytes(t[3]) == 0))
+      throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'property TYPE NAME' or 'property list "
+                                   "COUNT_TYPE TYPE NAME' of an element",
+                                   path, quoted(t)));
+    elements.back().least += ascii ? 1 : size;
+    elements.back().lists.push_back(list);
+  }
+}
+
+/// Whether the bytes after the header can hold the elements it declares.
+void checkPlyRoom(const std::vector<PlyElement>& elements, uint64_t data, bool ascii, const std::string& path) {
+  // ASCII: n values of a character each need n - 1 separators too, so n <= (bytes + 1) / 2.
+  uint64_t room = ascii ? (data + 1) / 2 : data;
+  for (const PlyElement& e : elements) {
+    if (e.least == 0) continue;
+    if (e.count > room / e.least)
+      throw InputError(fmt::format("{}: the PLY header declares {} '{}' elements, more than the {} bytes after the "
+                                   "header can hold (a truncated or corrupt file)",
+                                   path, e.count, e.name, data));
+    room -= e.count * e.least;
+  }
+}
+
+/// Whether the tokens of an ASCII data line are exactly one instance of an element whose
+/// properties are `lists` (true: a list, its count then that many values).
+bool isOnePlyInstance(const std::vector<std::string_view>& t, const std::vector<bool>& lists) {
+  std::size_t k = 0;
+  for (const bool list : lists) {
+    if (k >= t.size()) return false;
+    uint64_t n = 0;
+    if (list) {
+      const auto [ptr, ec] = std::from_chars(t[k].data(), t[k].data() + t[k].size(), n);
+      if (ec != std::errc{} || ptr != t[k].data() + t[k].size() || n > t.size() - k - 1) return false;
+    }
+    k += 1 + n;
+  }
+  return k == t.size();
+}
+
 /// Refuses kinds of PLY on which assimp 5.2 hangs or crashes instead of failing, found by
 /// fuzz_mesh: a header without its end_header line (assimp loops at the end of the file for
 /// ever), a malformed element or property line, a header declaring more element instances than
@@ -184,17 +259,7 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
     ++line_number;
     return true;
   };
-  struct Element {
-    std::string name;
-    uint64_t count = 0;
-    uint64_t least = 0;       // bytes (binary) or values (ASCII) one instance takes at least
-    std::vector<bool> lists;  // per property: a list (a count, then that many values)?
-  };
-  // A refused header line as the error message quotes it: its tokens, at most 60 characters.
-  const auto quoted = [](const std::vector<std::string_view>& tokens) {
-    return fmt::format("{}", fmt::join(tokens, " ")).substr(0, 60);
-  };
-  std::vector<Element> elements;
+  std::vector<PlyElement> elements;
   bool ascii = false, known_format = false;
   std::vector<std::string_view> t;
   nextLine(t);  // the magic line
@@ -206,73 +271,22 @@ void checkPlyHeader(const std::vector<char>& bytes, const std::string& path) {
     if (t[0] == "format" && t.size() >= 2) {
       ascii = t[1] == "ascii";
       known_format = ascii || t[1] == "binary_little_endian" || t[1] == "binary_big_endian";
-    } else if (t[0] == "element") {
-      // A count assimp would read some other way (fuzz_mesh: digits run into the name, and
-      // no count) is refused rather than left to it: it allocated 23 GB for one.
-      Element e;
-      bool counted = t.size() == 3;
-      if (counted) {
-        const char* end = t[2].data() + t[2].size();
-        const auto [ptr, ec] = std::from_chars(t[2].data(), end, e.count);
-        counted = ec == std::errc{} && ptr == end;
-      }
-      if (!counted)
-        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'element NAME COUNT'", path, quoted(t)));
-      e.name = std::string(t[1]);
-      elements.push_back(e);
-    } else if (t[0] == "property") {
-      // "property TYPE NAME", or "property list COUNT_TYPE ITEM_TYPE NAME": a list takes its
-      // count at least (it may be empty). Anything else is refused, as a malformed element
-      // line is: assimp read such a header its own way and then wild memory (fuzz_mesh).
-      const bool list = t.size() == 5 && t[1] == "list";
-      const std::size_t size = t.size() == 3 || list ? plyScalarBytes(list ? t[2] : t[1]) : 0;
-      if (elements.empty() || size == 0 || (list && plyScalarBytes(t[3]) == 0))
-        throw InputError(fmt::format("{}: a PLY header line reads '{}', not 'property TYPE NAME' or 'property list "
-                                     "COUNT_TYPE TYPE NAME' of an element",
-                                     path, quoted(t)));
-      elements.back().least += ascii ? 1 : size;
-      elements.back().lists.push_back(list);
+    } else {
+      readPlyDeclaration(t, ascii, path, elements);
     }
     // Other lines are skipped, as assimp skips them (Blender once wrote a bare text line).
   }
   if (!known_format) return;
-  // ASCII: n values of a character each need n - 1 separators too, so n <= (bytes + 1) / 2.
-  const uint64_t data = text.size() - std::min(pos, text.size());
-  uint64_t room = ascii ? (data + 1) / 2 : data;
-  for (const Element& e : elements) {
-    if (e.least == 0) continue;
-    if (e.count > room / e.least)
-      throw InputError(fmt::format("{}: the PLY header declares {} '{}' elements, more than the {} bytes after the "
-                                   "header can hold (a truncated or corrupt file)",
-                                   path, e.count, e.name, data));
-    room -= e.count * e.least;
-  }
+  checkPlyRoom(elements, text.size() - std::min(pos, text.size()), ascii, path);
   if (!ascii) return;
   // assimp reads an ASCII instance from each line, and a line with fewer values than a
   // list's count makes it read face indices that are not there (fuzz_mesh: an invalid read
   // in a post-processing step). Every instance must be one line of exactly its values.
-  for (const Element& e : elements)
+  for (const PlyElement& e : elements)
     for (uint64_t i = 0; i < e.count; ++i) {
       if (!nextLine(t))
         throw InputError(fmt::format("{}: the PLY data ends after {} of its {} '{}' elements", path, i, e.count, e.name));
-      std::size_t k = 0;
-      bool whole = true;
-      for (const bool list : e.lists) {
-        if (k >= t.size()) {
-          whole = false;
-          break;
-        }
-        uint64_t n = 0;
-        if (list) {
-          const auto [ptr, ec] = std::from_chars(t[k].data(), t[k].data() + t[k].size(), n);
-          if (ec != std::errc{} || ptr != t[k].data() + t[k].size() || n > t.size() - k - 1) {
-            whole = false;
-            break;
-          }
-        }
-        k += 1 + n;
-      }
-      if (!whole || k != t.size())
+      if (!isOnePlyInstance(t, e.lists))
         throw InputError(fmt::format("{}: line {} ('{}') is not one '{}' element as the PLY header declares it", path,
                                      line_number, fmt::format("{}", fmt::join(t, " ")).substr(0, 60), e.name));
     }

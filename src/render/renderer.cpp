@@ -36,12 +36,10 @@ void checkRenderable(const Mesh& mesh, const Camera& camera) {
   if (mesh.faces.empty()) throw InputError(fmt::format("mesh '{}' has no triangles to render", mesh.name));
 }
 
-}  // namespace
-
-Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& pose) {
-  checkRenderable(mesh, camera);
-  const ScreenParams sp(camera);
-  const int W = camera.width, H = camera.height;
+/// The reference's raster pass: per pixel the nearest face as (depth bits << 32 | face), the
+/// maximum where no face covers it (raster_depth.comp and raster_clipped.comp).
+std::vector<uint64_t> rasterizeReference(const Mesh& mesh, const ScreenParams& sp, const Pose& pose) {
+  const int W = sp.width, H = sp.height;
   std::vector<uint64_t> raster(static_cast<std::size_t>(W) * H, std::numeric_limits<uint64_t>::max());
   auto corners = [&](const Eigen::Vector3i& f) {
     return std::array<Eigen::Vector3f, 3>{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
@@ -70,6 +68,19 @@ Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& po
       for (int x = c.box_x0; x <= c.box_x1; ++x)
         if (render::insideClipped(c, x, y)) write(x, y, render::planeDepthAt(sp, c.n, c.n_p0, c.z_near, c.z_far, x, y), f);
   }
+  return raster;
+}
+
+}  // namespace
+
+Rendering renderReference(const Mesh& mesh, const Camera& camera, const Pose& pose) {
+  checkRenderable(mesh, camera);
+  const ScreenParams sp(camera);
+  const int W = camera.width, H = camera.height;
+  const std::vector<uint64_t> raster = rasterizeReference(mesh, sp, pose);
+  auto corners = [&](const Eigen::Vector3i& f) {
+    return std::array<Eigen::Vector3f, 3>{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+  };
   Rendering out;
   out.depth = cv::Mat::zeros(H, W, CV_32FC1);
   out.normals = cv::Mat::zeros(H, W, CV_32FC3);

@@ -94,6 +94,41 @@ std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite)
   return paths;
 }
 
+namespace {
+
+/// Step 3 of the demo: a bank per object, read from the cache when one was trained with the
+/// same mesh, camera and views before; each object's line in the report.
+std::map<int, TemplateBank> demoBanks(GpuContext& ctx, const DemoParams& params, const std::vector<std::string>& mesh_paths,
+                                      const Camera& camera, const DemoCallbacks& callbacks, DemoReport& report) {
+  std::map<int, TemplateBank> banks;
+  for (std::size_t i = 0; i < mesh_paths.size(); ++i) {
+    DemoObject obj;
+    obj.obj_id = static_cast<int>(i) + 1;
+    obj.mesh_path = mesh_paths[i];
+    const Mesh mesh = loadMesh(mesh_paths[i], MeshUnits::Millimetres);
+    obj.name = mesh.name;
+    TrainingParams tp;
+    tp.views = params.views;
+    tp.camera = camera;
+    const std::vector<TrainingView> views =
+        viewsAbove(sampleViews(tp.views, mesh.bboxCentre()), mesh.bboxCentre(), params.max_view_angle_deg);
+    if (callbacks.step) callbacks.step(fmt::format("Template bank of {} ({} views)", obj.name, views.size()));
+    const auto t_obj = std::chrono::steady_clock::now();
+    CachedBank cached = loadOrTrainBank(ctx, mesh, tp, views, params.cache_dir, callbacks.progress);
+    obj.train_s = msSince(t_obj) / 1e3;
+    obj.bank_path = cached.path;
+    obj.bank_from_cache = cached.from_cache;
+    obj.templates = cached.bank.templates.size();
+    if (callbacks.info) callbacks.info(fmt::format("{} templates, {} in {:.1f} s{}", obj.templates, cached.from_cache ? "read from the cache" : "trained",
+                     obj.train_s, cached.path.empty() ? "" : " (" + cached.path + ")"));
+    banks.emplace(obj.obj_id, std::move(cached.bank));
+    report.objects.push_back(std::move(obj));
+  }
+  return banks;
+}
+
+}  // namespace
+
 DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallbacks& callbacks) {
   validateDemoParams(params);
   const auto t_start = std::chrono::steady_clock::now();
@@ -128,30 +163,7 @@ DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallback
   // 3. A bank per object, read from the cache when one was trained with the same mesh,
   //    camera and views before.
   t = std::chrono::steady_clock::now();
-  std::map<int, TemplateBank> banks;
-  for (std::size_t i = 0; i < mesh_paths.size(); ++i) {
-    DemoObject obj;
-    obj.obj_id = static_cast<int>(i) + 1;
-    obj.mesh_path = mesh_paths[i];
-    const Mesh mesh = loadMesh(mesh_paths[i], MeshUnits::Millimetres);
-    obj.name = mesh.name;
-    TrainingParams tp;
-    tp.views = params.views;
-    tp.camera = synth.camera;
-    const std::vector<TrainingView> views =
-        viewsAbove(sampleViews(tp.views, mesh.bboxCentre()), mesh.bboxCentre(), params.max_view_angle_deg);
-    step(fmt::format("Template bank of {} ({} views)", obj.name, views.size()));
-    const auto t_obj = std::chrono::steady_clock::now();
-    CachedBank cached = loadOrTrainBank(ctx, mesh, tp, views, params.cache_dir, callbacks.progress);
-    obj.train_s = msSince(t_obj) / 1e3;
-    obj.bank_path = cached.path;
-    obj.bank_from_cache = cached.from_cache;
-    obj.templates = cached.bank.templates.size();
-    info(fmt::format("{} templates, {} in {:.1f} s{}", obj.templates, cached.from_cache ? "read from the cache" : "trained",
-                     obj.train_s, cached.path.empty() ? "" : " (" + cached.path + ")"));
-    banks.emplace(obj.obj_id, std::move(cached.bank));
-    report.objects.push_back(std::move(obj));
-  }
+  std::map<int, TemplateBank> banks = demoBanks(ctx, params, mesh_paths, synth.camera, callbacks, report);
   report.train_s = msSince(t) / 1e3;
 
   // 4. Detection and scoring; each image's overlay and JSON as it comes.

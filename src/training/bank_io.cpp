@@ -211,6 +211,51 @@ void writePayload(Writer& w, const TemplateBank& bank) {
   }
 }
 
+/// Template `i` of a bank of `levels` pyramid levels (saveBank's layout, docs/formats.md).
+BankTemplate readTemplate(Reader& r, uint32_t i, uint32_t levels) {
+  BankTemplate t;
+  for (int row = 0; row < 3; ++row)
+    for (int c = 0; c < 3; ++c) t.pose.R(row, c) = r.get<float>();
+  for (int k = 0; k < 3; ++k) t.pose.t[k] = r.get<float>();
+  t.distance = r.get<float>();
+  t.inplane_deg = r.get<float>();
+  t.viewpoint = r.get<int32_t>();
+  t.anchor_x = r.get<float>();
+  t.anchor_y = r.get<float>();
+  t.linemod.levels.resize(levels);
+  for (auto& level : t.linemod.levels) {
+    level.width = r.get<int32_t>();
+    level.height = r.get<int32_t>();
+    const auto n = r.get<uint32_t>();
+    if (n > 2 * 4096u) r.fail(fmt::format("template {} with {} features", i, n));
+    level.features.resize(n);
+    for (auto& f : level.features) {
+      f.x = r.get<int16_t>();
+      f.y = r.get<int16_t>();
+      f.bin = r.get<uint8_t>();
+      const auto m = r.get<uint8_t>();
+      if (m >= kModalityCount) r.fail(fmt::format("template {}: modality {}", i, m));
+      f.modality = static_cast<Modality>(m);
+    }
+  }
+  t.crop.x0 = r.get<int32_t>();
+  t.crop.y0 = r.get<int32_t>();
+  t.crop.stride = r.get<int32_t>();
+  t.crop.cols = r.get<int32_t>();
+  t.crop.rows = r.get<int32_t>();
+  // Training never makes a crop over kCropCells + 1 cells a side, and the cluster score's
+  // kernel relies on it: its loops over a crop's cells run within lavapipe's 65,535-step
+  // budget an invocation only for crops of about 180 x 180 cells or fewer (docs/measured.md).
+  constexpr int max_cells = kCropCells + 1;
+  if (t.crop.stride < 1 || t.crop.cols < 0 || t.crop.rows < 0 || t.crop.cols > max_cells || t.crop.rows > max_cells)
+    r.fail(fmt::format("template {}: crop {}x{} stride {} (training makes at most {}x{})", i, t.crop.cols,
+                       t.crop.rows, t.crop.stride, max_cells, max_cells));
+  const std::size_t cells = static_cast<std::size_t>(t.crop.cols) * t.crop.rows;
+  t.crop.depth_01mm = r.getArray<uint16_t>(cells);
+  t.crop.normals = r.getArray<int8_t>(cells * 3);
+  return t;
+}
+
 TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
   TemplateBank bank;
   bank.object = r.getString();
@@ -263,49 +308,7 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
   if (!(bank.diameter > 0.f)) r.fail("a diameter that is not positive");
   const auto count = r.get<uint32_t>();
   bank.templates.reserve(std::min<uint32_t>(count, 1u << 20));
-  for (uint32_t i = 0; i < count; ++i) {
-    BankTemplate t;
-    for (int row = 0; row < 3; ++row)
-      for (int c = 0; c < 3; ++c) t.pose.R(row, c) = r.get<float>();
-    for (int k = 0; k < 3; ++k) t.pose.t[k] = r.get<float>();
-    t.distance = r.get<float>();
-    t.inplane_deg = r.get<float>();
-    t.viewpoint = r.get<int32_t>();
-    t.anchor_x = r.get<float>();
-    t.anchor_y = r.get<float>();
-    t.linemod.levels.resize(levels);
-    for (auto& level : t.linemod.levels) {
-      level.width = r.get<int32_t>();
-      level.height = r.get<int32_t>();
-      const auto n = r.get<uint32_t>();
-      if (n > 2 * 4096u) r.fail(fmt::format("template {} with {} features", i, n));
-      level.features.resize(n);
-      for (auto& f : level.features) {
-        f.x = r.get<int16_t>();
-        f.y = r.get<int16_t>();
-        f.bin = r.get<uint8_t>();
-        const auto m = r.get<uint8_t>();
-        if (m >= kModalityCount) r.fail(fmt::format("template {}: modality {}", i, m));
-        f.modality = static_cast<Modality>(m);
-      }
-    }
-    t.crop.x0 = r.get<int32_t>();
-    t.crop.y0 = r.get<int32_t>();
-    t.crop.stride = r.get<int32_t>();
-    t.crop.cols = r.get<int32_t>();
-    t.crop.rows = r.get<int32_t>();
-    // Training never makes a crop over kCropCells + 1 cells a side, and the cluster score's
-    // kernel relies on it: its loops over a crop's cells run within lavapipe's 65,535-step
-    // budget an invocation only for crops of about 180 x 180 cells or fewer (docs/measured.md).
-    constexpr int max_cells = kCropCells + 1;
-    if (t.crop.stride < 1 || t.crop.cols < 0 || t.crop.rows < 0 || t.crop.cols > max_cells || t.crop.rows > max_cells)
-      r.fail(fmt::format("template {}: crop {}x{} stride {} (training makes at most {}x{})", i, t.crop.cols,
-                         t.crop.rows, t.crop.stride, max_cells, max_cells));
-    const std::size_t cells = static_cast<std::size_t>(t.crop.cols) * t.crop.rows;
-    t.crop.depth_01mm = r.getArray<uint16_t>(cells);
-    t.crop.normals = r.getArray<int8_t>(cells * 3);
-    bank.templates.push_back(std::move(t));
-  }
+  for (uint32_t i = 0; i < count; ++i) bank.templates.push_back(readTemplate(r, i, levels));
   if (version >= 4) {
     const auto symmetries = r.get<uint32_t>();
     if (symmetries > 64) r.fail(fmt::format("{} near-symmetries", symmetries));
