@@ -44,9 +44,10 @@ void replacePose(PoseCandidate& c, const Rendering& view, const Pose& pose, cons
   verifyCandidate(c, frame);
 }
 
-/// Each turn of the pose refit from where it lands (mls off, as stage 7 already smoothed).
-std::vector<RefineResult> refitTurns(const PoseCandidate& c, const PoseObject& object, const PoseFrame& frame,
-                                     unsigned threads, double& cpu_ms) {
+/// Each turn of the pose refit from where it lands (mls off, as stage 7 already smoothed); the
+/// refits' time goes to the candidate's cpu_ms.
+std::vector<RefineResult> refitTurns(PoseCandidate& c, const PoseObject& object, const PoseFrame& frame,
+                                     unsigned threads) {
   const auto& turns = object.look_alike_turns;
   std::vector<Pose> starts;
   for (const auto& h : turns) starts.push_back(compose(c.refined.pose, h.transform()));
@@ -64,7 +65,7 @@ std::vector<RefineResult> refitTurns(const PoseCandidate& c, const PoseObject& o
                                icp_params);
       },
       threads);
-  cpu_ms += msSince(start);
+  c.cpu_ms += msSince(start);
   return refits;
 }
 
@@ -175,7 +176,7 @@ void resolveLookAlikes(PoseCandidate& c, const PoseObject& object, const PoseFra
                        const DetectorParams& params) {
   const auto& turns = object.look_alike_turns;
   if (turns.empty() || !worthComparing(c)) return;
-  const std::vector<RefineResult> refits = refitTurns(c, object, frame, params.threads, c.cpu_ms);
+  const std::vector<RefineResult> refits = refitTurns(c, object, frame, params.threads);
   if (refits.empty()) return;
   // Each refit with the near-symmetries' turns too where colour can tell them (a carton
   // end for end shows another painted face on top): pose 0 is the kept one, then per
