@@ -13,7 +13,7 @@ PACKAGES=(
   libpcl-dev liboctomap-dev libmeshoptimizer-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev
-  python3-dev python3-pybind11 python3-numpy python3-pytest python3-opencv
+  python3-dev python3-pybind11 python3-numpy python3-pytest python3-opencv python3-distributed
 )
 
 missing=()

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -380,7 +382,8 @@ struct EvalRunParams {
   LinemodBaselineParams linemod;
   PpfParams ppf;
   EvalParams eval;
-  int max_images = 0;  ///< the first N images of the split; 0: all
+  int max_images = 0;  ///< N images of the split from first_image on; 0: all
+  int first_image = 0;  ///< the images before this one are left out (a slice of a run)
   /// Called with vkpose's result on each image (e.g. to write its overlay and JSON).
   std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> on_detections;
 };
@@ -425,10 +428,18 @@ struct MethodEvaluation {
   std::map<int, VisibilityRecall> by_visibility;
 };
 
+/// An image a run could not read (a missing or corrupt file): left out of the scores and named
+/// in the report, while the run goes on with the other images.
+struct SkippedImage {
+  int scene_id = 0, image_id = 0;
+  std::string reason;
+};
+
 struct EvalReport {
   std::string dataset, split, device;
   std::vector<int> objects;  ///< the evaluated obj_ids, ascending
-  int images = 0;
+  int images = 0;            ///< images scored (the skipped ones are not)
+  std::vector<SkippedImage> skipped;
   std::vector<MethodEvaluation> methods;  ///< in the order asked for
   std::vector<std::string> warnings;      ///< e.g. a bank trained for another focal length (once each)
 };
@@ -448,12 +459,64 @@ void checkBanksAgainstDataset(const std::map<int, TemplateBank>& banks, const Bo
 EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::map<int, TemplateBank>& banks,
                          const EvalRunParams& params = {}, const EvalProgress& progress = {});
 
+/// The estimators of a run (vkpose's detector with its banks on the device, the baselines, the
+/// models the poses are scored against), built once and then run on any images of the dataset:
+/// what a worker of a run spread over processes keeps between its batches. runEvaluation is
+/// an Evaluator run once on all of its images.
+class Evaluator {
+ public:
+  /// Checks as runEvaluation does; the device must outlive the Evaluator.
+  Evaluator(GpuContext& ctx, BopDataset dataset, const std::map<int, TemplateBank>& banks, const EvalRunParams& params);
+  ~Evaluator();
+  Evaluator(const Evaluator&) = delete;
+  Evaluator& operator=(const Evaluator&) = delete;
+
+  /// The images the parameters select (first_image, max_images): indices [first, second) of
+  /// the dataset's images.
+  std::pair<std::size_t, std::size_t> imageRange() const;
+  /// Runs and scores images [first, first + count) (indices into the dataset's images, within
+  /// imageRange()): a report of those images alone, which mergeEvalReports joins with the
+  /// others'. An image that cannot be read is skipped and named in the report.
+  EvalReport run(std::size_t first, std::size_t count, const EvalProgress& progress = {});
+
+  struct State;  ///< the estimators and what they score against (evaluation.cpp)
+
+ private:
+  std::unique_ptr<State> state_;
+};
+
+/// One report of a run from the reports of its slices (Evaluator::run on consecutive images,
+/// given in image order): counts and visibility summed, estimates and outcomes joined in image
+/// order, times averaged over the images, warnings and device names each once. Equal to the
+/// report of one Evaluator::run over all of them, times aside. InputError for reports of
+/// different runs (dataset, split, objects or methods differ) or none.
+EvalReport mergeEvalReports(const std::vector<EvalReport>& parts);
+
+/// Every field of a report as JSON, floats so that they read back equal: how a slice's report
+/// travels from a worker process. parseEvalReportState reads it back (InputError when it is
+/// not such a document).
+std::string evalReportState(const EvalReport& report);
+EvalReport parseEvalReportState(const std::string& json);
+
+/// A run as another process can repeat it: the dataset folder and split, the bank files by
+/// obj_id and every parameter. What `vkpose eval --workers` hands to vkpose.distributed.
+struct EvalJob {
+  std::string dataset, split = "test";
+  std::map<int, std::string> banks;  ///< obj_id -> bank file
+  EvalRunParams params;              ///< on_detections does not travel
+};
+std::string evalJobJson(const EvalJob& job);
+/// InputError naming what is wrong. linemod's match parameters are the detector's (as the CLI
+/// and Python set them).
+EvalJob parseEvalJob(const std::string& json);
+
 /// The report as JSON:
 /// {"methods": {"vkpose": {"average": {"precision", "recall", "f1", "ms_per_image"},
 ///                         "objects": {"1": {"precision", "recall", "f1", "ms_per_image",
 ///                                           "tp", "fp", "fn", "by_visibility"}, ...},
 ///                         "by_visibility": [...]}, ...},
-///  "dataset": ..., "split": ..., "images": N, "device": ...}
+///  "dataset": ..., "split": ..., "images": N, "skipped": [{"scene_id", "image_id", "reason"}],
+///  "device": ...}
 /// by_visibility (per object, and for all objects together): a VisibilityRecall bin each,
 /// {"visib_fract": [from, to], "instances": n, "found": k}.
 std::string evalReportJson(const EvalReport& report);

@@ -16,6 +16,10 @@
 #include "vkpose/device.hpp"
 #include "vkpose/geometry.hpp"
 
+namespace vkpose {
+struct BopResult;
+}  // namespace vkpose
+
 namespace vkpose::python {
 
 namespace py = pybind11;
@@ -86,5 +90,9 @@ void refuseOverwrite(const std::string& path, bool overwrite);
 void bindCore(py::module_& m);
 void bindDetect(py::module_& m);
 void bindData(py::module_& m);
+void bindEval(py::module_& m);
+
+/// A BOP results row as read_bop_results gives it: scene_id, im_id, obj_id, score, R, t, time.
+py::dict resultRow(const BopResult& r);
 
 }  // namespace vkpose::python

@@ -1,4 +1,4 @@
-// Frames from files, synthetic datasets, evaluation and BOP results files.
+// Frames from files, synthetic datasets and BOP results files.
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
@@ -113,6 +113,8 @@ SynthParams synthParamsOf(const py::object& meshes, const std::string& layout, u
   return params;
 }
 
+}  // namespace
+
 py::dict resultRow(const BopResult& r) {
   py::dict row;
   row["scene_id"] = r.scene_id;
@@ -124,6 +126,8 @@ py::dict resultRow(const BopResult& r) {
   row["time"] = r.time_s;
   return row;
 }
+
+namespace {
 
 BopResult resultOf(const py::handle& row, std::size_t index) {
   const std::string what = fmt::format("rows[{}]", index);
@@ -275,80 +279,6 @@ parts and the view).)");
       py::arg("camera_distance") = py::none(), py::arg("bin_size") = py::none(), py::arg("device") = py::none(),
       "One random synthetic frame in memory, image `index` of what synth() would write with these arguments: a dict "
       "with rgb (BGR uint8), depth (uint16 mm), camera (a Camera) and gt (obj_id, R, t per instance).");
-
-  m.def(
-      "evaluate",
-      [](const py::object& dataset, const py::dict& banks, const std::vector<std::string>& methods,
-         const std::string& split, const py::object& config, int images, float k_m, float min_visib,
-         const py::object& out, const py::object& report, const py::object& pr_curve, bool overwrite,
-         const py::object& device, const py::object& progress) {
-        EvalRunParams params;
-        params.detector = paramsOf(config);
-        params.linemod.match = params.detector.match;
-        params.methods.clear();
-        for (const std::string& name : methods) params.methods.push_back(parseEvalMethod(name));
-        params.max_images = images;
-        params.eval.k_m = k_m;
-        params.eval.min_visib_fract = min_visib;
-        if (images < 0) valueError(fmt::format("images: {} is negative", images));
-        if (!(k_m > 0)) valueError(fmt::format("k_m: {} is not positive", k_m));
-        const std::string root = pathOf(dataset, "dataset");
-        const std::string out_path = out.is_none() ? "" : pathOf(out, "out");
-        const std::string report_path = report.is_none() ? "" : pathOf(report, "report");
-        const std::string pr_path = pr_curve.is_none() ? "" : pathOf(pr_curve, "pr_curve");
-        if (!report_path.empty()) refuseOverwrite(report_path, overwrite);
-        if (!pr_path.empty()) refuseOverwrite(pr_path, overwrite);
-        if (!out_path.empty())
-          for (EvalMethod method : params.methods) refuseOverwrite(methodResultsPath(out_path, method), overwrite);
-        if (!std::filesystem::is_directory(root)) valueError(root + ": no such dataset folder");
-        std::map<int, TemplateBank> bank_map;
-        for (const auto& [key, value] : banks) {
-          if (!py::isinstance<py::int_>(key)) valueError("banks: expected {obj_id (int): Bank or bank path}");
-          const int id = key.cast<int>();
-          bank_map.emplace(id, py::isinstance<TemplateBank>(value) ? value.cast<const TemplateBank&>()
-                                                                    : loadBank(pathOf(value, "banks")));
-        }
-        const std::shared_ptr<Device> dev = deviceOf(device);
-        const auto step = progressOf(progress, "evaluating");
-        EvalReport r;
-        {
-          py::gil_scoped_release nogil;
-          const BopDataset data = loadBopDataset(root, split);
-          checkBanksAgainstDataset(bank_map, data);
-          std::lock_guard<std::mutex> lock(dev->mutex);
-          r = runEvaluation(dev->context, data, bank_map, params, step);
-        }
-        if (!report_path.empty()) writeTextFile(report_path, evalReportJson(r), true);
-        if (!pr_path.empty()) writeTextFile(pr_path, precisionRecallCsv(r), true);
-        if (!out_path.empty())
-          for (const MethodEvaluation& me : r.methods) saveBopResults(methodResultsPath(out_path, me.method), me.results);
-        py::dict doc = py::module_::import("json").attr("loads")(evalReportJson(r));
-        py::dict results;
-        for (const MethodEvaluation& me : r.methods) {
-          py::list rows;
-          for (const BopResult& b : me.results) rows.append(resultRow(b));
-          results[py::str(methodName(me.method))] = rows;
-        }
-        doc["results"] = results;
-        doc["warnings"] = r.warnings;
-        return doc;
-      },
-      py::arg("dataset"), py::arg("banks"), py::kw_only(),
-      py::arg("methods") = std::vector<std::string>{"vkpose", "linemod", "ppf"}, py::arg("split") = "test",
-      py::arg("config") = py::none(), py::arg("images") = 0, py::arg("k_m") = 0.15f, py::arg("min_visib") = 0.f,
-      py::arg("out") = py::none(), py::arg("report") = py::none(), py::arg("pr_curve") = py::none(),
-      py::arg("overwrite") = false,
-      py::arg("device") = py::none(), py::arg("progress") = py::none(),
-      R"(Scores vkpose and the paper's baselines side by side on a BOP dataset, as `vkpose eval` does.
-Returns the report `vkpose eval --report` writes, as a dict ({"methods": {name: {"average": ...,
-"objects": ...}}, "dataset", "split", "images", "device"}), plus "results": {method: rows as
-read_bop_results gives them} and "warnings".
-
-banks: {obj_id: Bank or bank path}. methods: any of 'vkpose', 'linemod', 'ppf'. config: the
-detector's stage parameters (as Detector takes them). images: the first N (0: all). k_m: an
-estimate is correct below k_m * diameter. out: BOP results CSV, METHOD_ put before the file
-name; report: the JSON report; pr_curve: the precision-recall curves CSV (`vkpose eval
---pr-curve`).)");
 }
 
 }  // namespace vkpose::python

@@ -1,6 +1,7 @@
 // The extension module vkpose._vkpose: errors, then the bindings by family (core: devices,
 // cameras, banks, training; detect: config, detector, detections, drawing; data: frames,
-// synthetic datasets, evaluation, BOP files). vkpose/__init__.py re-exports them.
+// synthetic datasets, BOP files; eval: evaluation, on one process or
+// spread over Dask's workers). vkpose/__init__.py re-exports them.
 #include "arrays.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/vkpose.hpp"
@@ -16,6 +17,7 @@ PYBIND11_MODULE(_vkpose, m) {
   bindCore(m);
   bindDetect(m);
   bindData(m);
+  bindEval(m);
   // Vulkan contexts go before the interpreter does, not in static destruction.
   py::module_::import("atexit").attr("register")(py::cpp_function([] { releaseDevices(); }));
 }

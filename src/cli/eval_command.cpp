@@ -3,10 +3,12 @@
 // protocol; prints a table, writes a JSON report and BOP results CSVs.
 #include <filesystem>
 #include <map>
+#include <thread>
 
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
+#include "cli/distributed_eval.hpp"
 #include "util/progress.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
@@ -22,6 +24,7 @@ struct EvalOptions {
   std::vector<std::string> banks, methods;
   bool force = false;
   EvalRunParams params;
+  DaskTarget dask;
 };
 
 /// "OBJ_ID=BANK" pairs -> obj_id -> bank path.
@@ -81,6 +84,35 @@ void printPrSummary(const EvalReport& report) {
   }
 }
 
+/// The report of the run: on this process, or spread over Dask's workers.
+EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const EvalRunParams& params) {
+  const BopDataset dataset = loadBopDataset(opt.dataset, opt.split);
+  const std::map<int, std::string> bank_paths = parseBankArgs(opt.banks);
+  if (opt.dask.workers > 0 || !opt.dask.scheduler.empty()) {
+    EvalJob job;
+    job.dataset = std::filesystem::absolute(opt.dataset).string();
+    job.split = opt.split;
+    job.params = params;
+    // Every worker reads the banks itself; on this machine's cluster the cores are shared out.
+    for (const auto& [obj_id, path] : bank_paths) {
+      if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": no such bank file");
+      job.banks[obj_id] = std::filesystem::absolute(path).string();
+    }
+    if (job.params.detector.threads == 0 && opt.dask.workers > 0)
+      job.params.detector.threads = std::max(1u, std::thread::hardware_concurrency() / static_cast<unsigned>(opt.dask.workers));
+    return runOnDask(job, opt.dask, global.quiet);
+  }
+  std::map<int, TemplateBank> banks;
+  for (const auto& [obj_id, path] : bank_paths) banks.emplace(obj_id, loadBank(path));
+  checkBanksAgainstDataset(banks, dataset);
+  GpuContext ctx(global.gpu());
+  ProgressBar bar("evaluating", global.quiet);
+  EvalReport report =
+      runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
+  bar.finish();
+  return report;
+}
+
 /// `vkpose eval`.
 ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
   EvalRunParams params = opt.params;
@@ -95,16 +127,7 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
   if (!std::filesystem::is_directory(opt.dataset))
     throw InputError(opt.dataset + ": no such dataset folder");
 
-  const BopDataset dataset = loadBopDataset(opt.dataset, opt.split);
-  std::map<int, TemplateBank> banks;
-  for (const auto& [obj_id, path] : parseBankArgs(opt.banks)) banks.emplace(obj_id, loadBank(path));
-  checkBanksAgainstDataset(banks, dataset);
-
-  GpuContext ctx(global.gpu());
-  ProgressBar bar("evaluating", global.quiet);
-  const EvalReport report =
-      runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
-  bar.finish();
+  const EvalReport report = evaluate(opt, global, params);
   for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
   fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
@@ -127,7 +150,10 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
       saveBopResults(path, m.results);
       if (!global.quiet) fmt::print("wrote {} ({} estimates)\n", path, m.results.size());
     }
-  return kOk;
+  // Unreadable images do not stop a long run, but a script must notice them.
+  for (const SkippedImage& s : report.skipped)
+    fmt::print(stderr, "vkpose: error: scene {} image {} skipped: {}\n", s.scene_id, s.image_id, s.reason);
+  return report.skipped.empty() ? kOk : kBadInput;
 }
 
 }  // namespace
@@ -154,6 +180,28 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
+  sub->add_option("--threads", p.detector.threads,
+                  "CPU threads for the pose stages (0: every core; with --workers: the cores shared out among the "
+                  "workers)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  auto* spread = "Spread over Dask's workers (python3-distributed; docs/evaluation.md)";
+  auto* workers = sub->add_option("--workers", opt->dask.workers,
+                                  "Run the images on N worker processes of a Dask cluster on this machine")
+                      ->check(CLI::Range(1, 1024))
+                      ->group(spread);
+  sub->add_option("--dask", opt->dask.scheduler,
+                  "Run the images on the workers of the Dask scheduler at ADDRESS (tcp://host:8786); the dataset and "
+                  "banks must be at the same paths on every worker")
+      ->excludes(workers)
+      ->group(spread);
+  sub->add_option("--connect-timeout", opt->dask.connect_timeout_s, "Seconds to wait for the --dask scheduler")
+      ->check(CLI::Range(1, 3600))
+      ->capture_default_str()
+      ->group(spread);
+  sub->add_option("--batch", opt->dask.batch, "Images per Dask task (0: about 4 tasks a worker)")
+      ->check(CLI::Range(0, 100000))
+      ->group(spread);
   addConfigOption(sub, opt->config);
   addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
   auto* protocol = "Evaluation protocol";

@@ -90,8 +90,20 @@ void checkBanksAgainstDataset(const std::map<int, TemplateBank>& banks, const Bo
   }
 }
 
-EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::map<int, TemplateBank>& banks,
-                         const EvalRunParams& params, const EvalProgress& progress) {
+struct Evaluator::State {
+  State(GpuContext& c, BopDataset d, const EvalRunParams& p) : ctx(c), dataset(std::move(d)), params(p) {}
+  GpuContext& ctx;
+  BopDataset dataset;
+  EvalRunParams params;
+  std::vector<int> objects;  ///< the evaluated obj_ids, ascending; bank index b is objects[b]
+  std::map<int, EvalModel> models;
+  std::optional<Detector> detector;
+  std::optional<LinemodBaseline> linemod;
+  std::optional<PpfBaseline> ppf;
+};
+
+Evaluator::Evaluator(GpuContext& ctx, BopDataset dataset, const std::map<int, TemplateBank>& banks,
+                     const EvalRunParams& params) {
   if (params.methods.empty()) throw InputError("no method to evaluate");
   const std::set<EvalMethod> unique(params.methods.begin(), params.methods.end());
   if (unique.size() != params.methods.size()) throw InputError("a method is asked for twice");
@@ -99,104 +111,152 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
   if (needs_banks && banks.empty())
     throw InputError("vkpose and linemod need a template bank per object: --bank OBJ_ID=BANK");
   if (params.max_images < 0) throw InputError("the number of images must be >= 0");
+  if (params.first_image < 0) throw InputError("the first image must be >= 0");
   checkBanksAgainstDataset(banks, dataset);
   if (dataset.images.empty()) throw InputError(fmt::format("{} has no annotated {} images", dataset.root, dataset.split));
+  if (static_cast<std::size_t>(params.first_image) >= dataset.images.size())
+    throw InputError(fmt::format("{} has {} annotated {} images: none from image {} on", dataset.root,
+                                 dataset.images.size(), dataset.split, params.first_image));
 
-  EvalReport report;
-  report.dataset = dataset.root;
-  report.split = dataset.split;
-  report.device = ctx.device().name;
-  for (const auto& [obj_id, bank] : banks) report.objects.push_back(obj_id);
+  state_ = std::make_unique<State>(ctx, std::move(dataset), params);
+  State& s = *state_;
+  for (const auto& [obj_id, bank] : banks) s.objects.push_back(obj_id);
   if (banks.empty())
-    for (const auto& [obj_id, info] : dataset.models) report.objects.push_back(obj_id);
-  const std::set<int> evaluated(report.objects.begin(), report.objects.end());
-  std::map<int, EvalModel> models = loadEvalModels(dataset);
-  std::erase_if(models, [&](const auto& m) { return !evaluated.count(m.first); });
+    for (const auto& [obj_id, info] : s.dataset.models) s.objects.push_back(obj_id);
+  const std::set<int> evaluated(s.objects.begin(), s.objects.end());
+  s.models = loadEvalModels(s.dataset);
+  std::erase_if(s.models, [&](const auto& m) { return !evaluated.count(m.first); });
 
-  // The estimators; banks in obj_id order, so bank index b is report.objects[b].
-  std::vector<TemplateBank> bank_list;
+  std::vector<TemplateBank> bank_list;  // in obj_id order
   for (const auto& [obj_id, bank] : banks) bank_list.push_back(bank);
-  std::optional<Detector> detector;
-  std::optional<LinemodBaseline> linemod;
-  std::optional<PpfBaseline> ppf;
-  if (unique.count(EvalMethod::Vkpose)) detector.emplace(ctx, bank_list, params.detector);
-  if (unique.count(EvalMethod::Linemod)) linemod.emplace(ctx, bank_list, params.linemod);
+  if (unique.count(EvalMethod::Vkpose)) s.detector.emplace(ctx, bank_list, params.detector);
+  if (unique.count(EvalMethod::Linemod)) s.linemod.emplace(ctx, bank_list, params.linemod);
   if (unique.count(EvalMethod::Ppf)) {
-    ppf.emplace(params.ppf);
-    for (int obj_id : report.objects) ppf->addObject(obj_id, loadMesh(dataset.modelPath(obj_id), MeshUnits::Millimetres));
+    s.ppf.emplace(params.ppf);
+    for (int obj_id : s.objects)
+      s.ppf->addObject(obj_id, loadMesh(s.dataset.modelPath(obj_id), MeshUnits::Millimetres));
   }
+}
 
-  const std::size_t n_images = params.max_images > 0
-                                   ? std::min(dataset.images.size(), static_cast<std::size_t>(params.max_images))
-                                   : dataset.images.size();
-  report.images = static_cast<int>(n_images);
+Evaluator::~Evaluator() = default;
+
+std::pair<std::size_t, std::size_t> Evaluator::imageRange() const {
+  const std::size_t n = state_->dataset.images.size();
+  const auto first = static_cast<std::size_t>(state_->params.first_image);
+  const auto max = static_cast<std::size_t>(state_->params.max_images);
+  return {first, max > 0 ? std::min(n, first + max) : n};
+}
+
+namespace {
+/// One method's estimates on one image, and the time they took (template upload left out).
+std::vector<PoseEstimate> estimatesOf(Evaluator::State& s, MethodRun& run, const BopImage& im,
+                                      const LinemodFrame& frame, double& image_ms, std::set<std::string>& warnings) {
+  std::vector<PoseEstimate> estimates;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (run.method == EvalMethod::Ppf) {
+    const PpfResult r = s.ppf->detect(frame.depth_mm, im.camera);
+    image_ms = msSince(t0);
+    for (const auto& d : r.detections) estimates.push_back(estimateOf(d.obj_id, d.score, d.pose));
+    for (const auto& [obj_id, ms] : r.object_ms) run.object_ms[obj_id] += ms + r.scene_ms;
+    return estimates;
+  }
+  const DetectionResult r =
+      run.method == EvalMethod::Vkpose ? s.detector->detect(frame, im.camera) : s.linemod->detect(frame, im.camera);
+  // The first frame uploads the templates: set-up, like training, not per-image work.
+  image_ms = msSince(t0);
+  for (const auto& [stage, ms] : r.timings_ms)
+    if (stage == "upload") image_ms -= ms;
+  warnings.insert(r.warnings.begin(), r.warnings.end());
+  if (run.method == EvalMethod::Vkpose && s.params.on_detections) s.params.on_detections(im, frame, r);
+  for (const auto& d : r.detections)
+    estimates.push_back(estimateOf(s.objects[static_cast<std::size_t>(d.bank)], d.score, d.pose));
+  for (int obj_id : s.objects) run.object_ms[obj_id] += image_ms;
+  return estimates;
+}
+
+/// Adds one image's estimates to the method's counts, outcomes and results.
+void scoreImage(const Evaluator::State& s, MethodRun& run, const BopImage& im,
+                const std::vector<PoseEstimate>& estimates, double image_ms) {
+  std::vector<GroundTruthPose> gt;
+  for (const auto& g : im.gt)
+    if (s.models.count(g.obj_id)) gt.push_back(g);
+  try {
+    const ImageEvaluation evaluation = evaluateImage(estimates, gt, s.models, s.params.eval);
+    for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
+    for (const auto& [obj_id, v] : evaluation.by_visibility) run.by_visibility[obj_id] += v;
+    for (std::size_t e = 0; e < estimates.size(); ++e)
+      run.outcomes.push_back({estimates[e].obj_id, estimates[e].score, evaluation.matches[e].gt >= 0,
+                              evaluation.matches[e].ignored});
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{} on scene {} image {}: {}", methodName(run.method), im.scene_id, im.image_id,
+                                 e.what()));
+  }
+  for (const auto& e : estimates) run.results.push_back({im.scene_id, im.image_id, e, image_ms / 1e3});
+}
+
+MethodEvaluation finishRun(MethodRun& run, const std::vector<int>& objects, int images) {
+  for (int obj_id : objects) {  // objects never seen still count (as zeros)
+    run.counts[obj_id];
+    run.by_visibility[obj_id];
+  }
+  MethodEvaluation m;
+  m.method = run.method;
+  m.summary = summarize(run.counts);
+  const double n = std::max(images, 1);
+  m.ms_per_image = run.total_ms / n;
+  for (const auto& [obj_id, ms] : run.object_ms) m.object_ms_per_image[obj_id] = ms / n;
+  m.results = std::move(run.results);
+  m.outcomes = std::move(run.outcomes);
+  m.by_visibility = std::move(run.by_visibility);
+  return m;
+}
+}  // namespace
+
+EvalReport Evaluator::run(std::size_t first, std::size_t count, const EvalProgress& progress) {
+  State& s = *state_;
+  const auto [begin, end] = imageRange();
+  if (first < begin || count > end - first || first > end)
+    throw InputError(fmt::format("images {} to {} are not among the run's images {} to {}", first, first + count,
+                                 begin, end));
+  EvalReport report;
+  report.dataset = s.dataset.root;
+  report.split = s.dataset.split;
+  report.device = s.ctx.device().name;
+  report.objects = s.objects;
   std::vector<MethodRun> runs;
-  for (EvalMethod m : params.methods) runs.push_back({m, {}, 0, {}, {}});
+  for (EvalMethod m : s.params.methods) runs.push_back({m, {}, 0, {}, {}, {}, {}});
   std::set<std::string> warnings;
   std::size_t step = 0;
-  for (std::size_t i = 0; i < n_images; ++i) {
-    const BopImage& im = dataset.images[i];
-    const LinemodFrame frame = loadFrame(im.rgb_path, im.depth_path, im.camera.depth_scale);
-    std::vector<GroundTruthPose> gt;
-    for (const auto& g : im.gt)
-      if (evaluated.count(g.obj_id)) gt.push_back(g);
-
+  for (std::size_t i = first; i < first + count; ++i) {
+    const BopImage& im = s.dataset.images[i];
+    LinemodFrame frame;
+    try {
+      frame = loadFrame(im.rgb_path, im.depth_path, im.camera.depth_scale);
+    } catch (const InputError& e) {  // one bad file does not end a long run: it is named in the report
+      report.skipped.push_back({im.scene_id, im.image_id, e.what()});
+      step += runs.size();
+      if (progress) progress(step, count * runs.size());
+      continue;
+    }
+    ++report.images;
     for (MethodRun& run : runs) {
-      std::vector<PoseEstimate> estimates;
-      const auto t0 = std::chrono::steady_clock::now();
       double image_ms = 0;
-      if (run.method == EvalMethod::Ppf) {
-        const PpfResult r = ppf->detect(frame.depth_mm, im.camera);
-        image_ms = msSince(t0);
-        for (const auto& d : r.detections) estimates.push_back(estimateOf(d.obj_id, d.score, d.pose));
-        for (const auto& [obj_id, ms] : r.object_ms) run.object_ms[obj_id] += ms + r.scene_ms;
-      } else {
-        const DetectionResult r =
-            run.method == EvalMethod::Vkpose ? detector->detect(frame, im.camera) : linemod->detect(frame, im.camera);
-        // The first frame uploads the templates: set-up, like training, not per-image work.
-        image_ms = msSince(t0);
-        for (const auto& [stage, ms] : r.timings_ms)
-          if (stage == "upload") image_ms -= ms;
-        warnings.insert(r.warnings.begin(), r.warnings.end());
-        if (run.method == EvalMethod::Vkpose && params.on_detections) params.on_detections(im, frame, r);
-        for (const auto& d : r.detections)
-          estimates.push_back(estimateOf(report.objects[static_cast<std::size_t>(d.bank)], d.score, d.pose));
-        for (int obj_id : report.objects) run.object_ms[obj_id] += image_ms;
-      }
+      const std::vector<PoseEstimate> estimates = estimatesOf(s, run, im, frame, image_ms, warnings);
       run.total_ms += image_ms;
-      try {
-        const ImageEvaluation evaluation = evaluateImage(estimates, gt, models, params.eval);
-        for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
-        for (const auto& [obj_id, v] : evaluation.by_visibility) run.by_visibility[obj_id] += v;
-        for (std::size_t e = 0; e < estimates.size(); ++e)
-          run.outcomes.push_back({estimates[e].obj_id, estimates[e].score, evaluation.matches[e].gt >= 0,
-                                  evaluation.matches[e].ignored});
-      } catch (const InputError& e) {
-        throw InputError(fmt::format("{} on scene {} image {}: {}", methodName(run.method), im.scene_id, im.image_id,
-                                     e.what()));
-      }
-      for (const auto& e : estimates) run.results.push_back({im.scene_id, im.image_id, e, image_ms / 1e3});
-      if (progress) progress(++step, n_images * runs.size());
+      scoreImage(s, run, im, estimates, image_ms);
+      if (progress) progress(++step, count * runs.size());
     }
   }
-
-  for (MethodRun& run : runs) {
-    for (int obj_id : report.objects) {  // objects never seen still count (as zeros)
-      run.counts[obj_id];
-      run.by_visibility[obj_id];
-    }
-    MethodEvaluation m;
-    m.method = run.method;
-    m.summary = summarize(run.counts);
-    m.ms_per_image = run.total_ms / static_cast<double>(n_images);
-    for (const auto& [obj_id, ms] : run.object_ms) m.object_ms_per_image[obj_id] = ms / static_cast<double>(n_images);
-    m.results = std::move(run.results);
-    m.outcomes = std::move(run.outcomes);
-    m.by_visibility = std::move(run.by_visibility);
-    report.methods.push_back(std::move(m));
-  }
+  for (MethodRun& run : runs) report.methods.push_back(finishRun(run, s.objects, report.images));
   report.warnings.assign(warnings.begin(), warnings.end());
   return report;
+}
+
+EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::map<int, TemplateBank>& banks,
+                         const EvalRunParams& params, const EvalProgress& progress) {
+  Evaluator evaluator(ctx, dataset, banks, params);
+  const auto [begin, end] = evaluator.imageRange();
+  return evaluator.run(begin, end - begin, progress);
 }
 
 std::vector<PrPoint> precisionRecallCurve(const std::vector<ScoredOutcome>& outcomes, int instances, int obj_id) {
@@ -319,10 +379,14 @@ std::string evalReportJson(const EvalReport& report) {
         {"objects", objects},
         {"by_visibility", binsJson(allObjects(m.by_visibility))}};
   }
+  json skipped = json::array();
+  for (const SkippedImage& s : report.skipped)
+    skipped.push_back({{"scene_id", s.scene_id}, {"image_id", s.image_id}, {"reason", s.reason}});
   const json doc = {{"methods", methods},
                     {"dataset", report.dataset},
                     {"split", report.split},
                     {"images", report.images},
+                    {"skipped", skipped},
                     {"device", report.device}};
   return doc.dump(2) + "\n";
 }
