@@ -40,6 +40,9 @@ struct DetectBenchOptions {
 struct StageStats {
   std::string stage;
   double median_ms = 0, p95_ms = 0, mean_ms = 0;
+  /// Of mean_ms, the GPU's own time (device timestamps; 0 for CPU stages and where the queue
+  /// writes none) and the rest, the host's: recording, submits, waits, readbacks, the CPU work.
+  double kernel_ms = 0, host_ms = 0;
 };
 
 struct DetectBenchReport {

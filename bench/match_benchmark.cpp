@@ -137,7 +137,15 @@ std::vector<MatchBenchRow> runMatchBenchmark(const MatchBenchOptions& o, const G
       LinemodMatcher matcher(ctx, fp, mp);
       matcher.setTemplates({templates.begin(), templates.begin() + count});
       std::vector<Match> ours = matcher.match(frame);  // warm-up, uploads templates
-      for (int r = 0; r < o.repeats; ++r) times.push_back(timeMs([&] { ours = matcher.match(frame); }));
+      row.stages = {{"features"}, {"similarity"}, {"match_readback"}};
+      for (int r = 0; r < o.repeats; ++r) {
+        times.push_back(timeMs([&] { ours = matcher.match(frame); }));
+        const MatchTimings& t = matcher.lastTimings();
+        const double n = o.repeats;
+        row.stages[0].ms += t.features_ms / n, row.stages[0].kernel_ms += t.features_kernel_ms / n;
+        row.stages[1].ms += (t.pruning_ms + t.similarity_ms) / n, row.stages[1].kernel_ms += t.similarity_kernel_ms / n;
+        row.stages[2].ms += t.finish_ms / n;
+      }
       row.vkpose_ms = median(times);
       row.vkpose_matches = ours.size();
       row.passes = matcher.lastTimings().passes;

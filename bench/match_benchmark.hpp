@@ -36,6 +36,13 @@ struct MatchBenchRow {
   std::size_t passes = 0;            ///< similarity passes per frame (MatchTimings::passes)
   std::size_t attempts = 0;          ///< similarity submits per frame, overflowed ones included
   std::size_t coarse_candidates = 0;
+  /// vkpose's stages, mean of the timed runs: wall ms and, of it, the GPU's own time (device
+  /// timestamps; 0 where the queue writes none). The rest is the host's.
+  struct Stage {
+    std::string name;
+    double ms = 0, kernel_ms = 0;
+  };
+  std::vector<Stage> stages;  ///< features, similarity, match_readback
   std::size_t gpu_peak_bytes = 0;    ///< the most our GPU buffers held at once during this row
   std::size_t rss_bytes = 0;         ///< resident memory after vkpose's runs (templates, matcher)
   std::size_t peak_rss_bytes = 0;    ///< the process's peak resident memory after this row

@@ -139,6 +139,22 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   for (const auto& s : stages) EXPECT_TRUE(j.at("stages").contains(s)) << s;
   EXPECT_TRUE(j.at("memory").contains("gpu_peak_bytes"));
   EXPECT_TRUE(j.contains("opencv"));
+  // The kernel/host split: lavapipe writes timestamps, so the GPU stages have device time, no
+  // more than the stage took; the CPU stages have none; host is the rest.
+  for (const auto& s : r.stages) {
+    EXPECT_GE(s.kernel_ms, 0.0) << s.stage;
+    EXPECT_LE(s.kernel_ms, s.mean_ms * 1.01 + 0.01) << s.stage;
+    EXPECT_NEAR(s.host_ms, s.mean_ms - s.kernel_ms, 1e-9) << s.stage;
+    const bool gpu = s.stage == "features" || s.stage == "similarity" || s.stage == "total";
+    if (gpu) {
+      EXPECT_GT(s.kernel_ms, 0.0) << s.stage << ": no device time measured";
+    }
+    if (s.stage == "clustering" || s.stage == "mls" || s.stage == "icp") {
+      EXPECT_EQ(s.kernel_ms, 0.0) << s.stage;
+    }
+    EXPECT_TRUE(j.at("stages").at(s.stage).contains("kernel_ms")) << s.stage;
+    EXPECT_TRUE(j.at("stages").at(s.stage).contains("host_ms")) << s.stage;
+  }
   // The pose stages' wall and CPU time and their threads.
   EXPECT_GT(r.pose_wall_ms, 0.0);
   EXPECT_GT(r.pose_cpu_ms, 0.0);

@@ -85,6 +85,10 @@ struct DetectionResult {
   std::vector<Detection> detections;  ///< best score first
   std::vector<Detection> rejected;    ///< hypotheses that stages 6-8 rejected, with the reason
   StageTimings timings_ms;
+  /// The GPU's own time within each stage of timings_ms that the detector times itself (device
+  /// timestamps of the submits it waited for; 0 where the queue writes none): a stage's
+  /// timings_ms less this is host work (recording, submitting, waiting, reading back, the CPU).
+  StageTimings kernel_ms;
   std::size_t matches = 0, hypotheses = 0, scored_hypotheses = 0;  ///< counts after stages 2, 3, 4
   /// Stage 2's depth-guided pruning (MatchParams::depth_pruning): (template, position) pairs
   /// of the coarse pass, those whose scene depth does not suit the template's distance, and

@@ -40,6 +40,10 @@ nlohmann::json printMatchRows(const std::vector<bench::MatchBenchRow>& rows) {
                           {"gpu_peak_bytes", r.gpu_peak_bytes},
                           {"rss_bytes", r.rss_bytes},
                           {"peak_rss_bytes", r.peak_rss_bytes}};
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& st : r.stages)
+      stages[st.name] = {{"mean_ms", st.ms}, {"kernel_ms", st.kernel_ms}, {"host_ms", st.ms - st.kernel_ms}};
+    row["stages"] = stages;
     if (r.objects > 0) row["objects"] = r.objects;
     if (r.opencv_ms > 0) {
       row["opencv_ms"] = r.opencv_ms;
@@ -47,6 +51,17 @@ nlohmann::json printMatchRows(const std::vector<bench::MatchBenchRow>& rows) {
       row["opencv_matches"] = r.opencv_matches;
     }
     out.push_back(row);
+  }
+  // Where each row's time goes: the GPU's own time (device timestamps) and the host's rest.
+  fmt::print("\n{:>9}  {:>26}  {:>26}  {:>14}\n", "templates", "features ms (kernel/host)",
+             "similarity ms (kernel/host)", "readback ms");
+  for (const auto& r : rows) {
+    std::string cells;
+    for (const auto& st : r.stages)
+      cells += st.name == "match_readback"
+                   ? fmt::format("  {:>14.1f}", st.ms)
+                   : fmt::format("  {:>26}", fmt::format("{:.1f} ({:.1f}/{:.1f})", st.ms, st.kernel_ms, st.ms - st.kernel_ms));
+    fmt::print("{:>9}{}\n", r.templates, cells);
   }
   return out;
 }

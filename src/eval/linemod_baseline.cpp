@@ -39,7 +39,7 @@ DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera&
   DetectionResult result;
   const auto total0 = std::chrono::steady_clock::now();
   const std::vector<Match> matches = matcher_->match(frame);  // best first
-  appendMatchTimings(matcher_->lastTimings(), result.timings_ms);
+  appendMatchTimings(matcher_->lastTimings(), result);
   result.matches = matches.size();
 
   // Each match is a one-member hypothesis centred where the match puts the object's centre:

@@ -37,6 +37,7 @@ Batch::~Batch() {
   // Nothing may be destroyed under work still running.
   if (in_flight_) (void)device_.waitForFences(fence_, VK_TRUE, UINT64_MAX);
   if (timestamp_pool_) device_.destroyQueryPool(timestamp_pool_);
+  if (busy_pool_) device_.destroyQueryPool(busy_pool_);
   device_.destroyFence(fence_);
   device_.freeCommandBuffers(ctx_.state().command_pool, cmd_);
   for (auto pool : pools_) device_.destroyDescriptorPool(pool);
@@ -48,7 +49,14 @@ void Batch::begin() {
   wait();  // the command buffer, staging buffers and descriptor sets of a flushed batch
   cmd_.begin({.flags = vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
   recording_ = true;
+  if (ctx_.state().timestamp_mask != 0) {
+    if (!busy_pool_) busy_pool_ = device_.createQueryPool({.queryType = vk::QueryType::eTimestamp, .queryCount = 2});
+    cmd_.resetQueryPool(busy_pool_, 0, 2);
+    cmd_.writeTimestamp(vk::PipelineStageFlagBits::eTopOfPipe, busy_pool_, 0);
+  }
 }
+
+double deviceMilliseconds(const GpuContext& ctx) { return static_cast<double>(ctx.state().device_ns.load()) * 1e-6; }
 
 void Batch::barrier() {
   vk::MemoryBarrier b{.srcAccessMask = vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eTransferWrite,
@@ -216,6 +224,7 @@ void Batch::flush() {
                             .dstAccessMask = vk::AccessFlagBits::eHostRead};
   cmd_.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer | vk::PipelineStageFlagBits::eComputeShader,
                        vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+  if (busy_pool_) cmd_.writeTimestamp(vk::PipelineStageFlagBits::eBottomOfPipe, busy_pool_, 1);
   cmd_.end();
   recording_ = false;
   vk::SubmitInfo submit{.commandBufferCount = 1, .pCommandBuffers = &cmd_};
@@ -235,6 +244,15 @@ void Batch::wait() {
                                   timestamp_values_.data(), 8, vk::QueryResultFlagBits::e64) != vk::Result::eSuccess)
     throw DeviceError("reading the GPU timestamps failed");
   timestamps_recorded_ = 0;
+  if (busy_pool_) {
+    uint64_t ends[2] = {0, 0};
+    if (device_.getQueryPoolResults(busy_pool_, 0, 2, sizeof ends, ends, 8, vk::QueryResultFlagBits::e64) ==
+        vk::Result::eSuccess) {
+      auto& state = ctx_.state();
+      const uint64_t ticks = (ends[1] - ends[0]) & state.timestamp_mask;
+      state.device_ns += static_cast<uint64_t>(static_cast<double>(ticks) * state.timestamp_period_ns);
+    }
+  }
   for (const auto& d : downloads_) std::memcpy(d.dst, staging_[d.staging].mapped(), d.bytes);
   downloads_.clear();
   staging_used_ = 0;

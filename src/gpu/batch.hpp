@@ -78,6 +78,7 @@ class Batch {
   /// Device time between two timestamps of the last submit, in milliseconds.
   double millisecondsBetween(uint32_t first, uint32_t second) const;
   static constexpr uint32_t kMaxTimestamps = 8;
+  const GpuContext& context() const { return ctx_; }
 
  private:
   void begin();
@@ -103,12 +104,17 @@ class Batch {
   };
   std::vector<PendingDownload> downloads_;
   vk::QueryPool timestamp_pool_;
+  vk::QueryPool busy_pool_;  ///< the submit's first and last timestamps (deviceMilliseconds)
   uint32_t timestamps_recorded_ = 0;
   std::vector<uint64_t> timestamp_values_;  ///< of the last submit
   bool recording_ = false;
   bool in_flight_ = false;
   bool profile_ = false;  ///< VKPOSE_PROFILE_KERNELS=1: submit after each dispatch and time it
 };
+
+/// Device time of every submit of `ctx` waited for so far, milliseconds (0 where the queue
+/// writes no timestamps): the difference across a stage is the GPU's own share of its time.
+double deviceMilliseconds(const GpuContext& ctx);
 
 /// Milliseconds per kernel name accumulated while VKPOSE_PROFILE_KERNELS is set (the
 /// per-dispatch submits make the total slower than a normal frame).

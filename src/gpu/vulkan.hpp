@@ -24,6 +24,9 @@ struct ContextState {
   vk::PhysicalDeviceMemoryProperties memory;
   GpuDeviceInfo info;
   std::atomic<uint32_t> validation_errors{0};
+  /// Device time of every submit waited for so far, nanoseconds (from timestamps at each
+  /// command buffer's start and end; stays 0 where the queue writes none).
+  std::atomic<uint64_t> device_ns{0};
   /// Bytes of the buffers of this context alive now, and the most they may add up to: the
   /// largest device-local heap, or VKPOSE_GPU_MEMORY_LIMIT_MIB when set (tests lower it).
   std::atomic<uint64_t> allocated_bytes{0};

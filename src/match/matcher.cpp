@@ -141,7 +141,9 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
       // its device time.
       batch.wait();
       if (p.timestamps) {
-        timings_.features_ms = p.features_record_ms + batch.millisecondsBetween(p.features_begin, p.features_end);
+        timings_.features_kernel_ms = batch.millisecondsBetween(p.features_begin, p.features_end);
+        timings_.similarity_kernel_ms = batch.millisecondsBetween(p.features_end, p.similarity_end);
+        timings_.features_ms = p.features_record_ms + timings_.features_kernel_ms;
         timings_.similarity_ms = wall_clock ? std::max(0.0, msSince(p.started) - timings_.features_ms)
                                             : batch.millisecondsBetween(p.features_end, p.similarity_end);
       } else {
@@ -149,9 +151,11 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
       }
     } else {
       const auto t0 = std::chrono::steady_clock::now();
+      const double device0 = gpu::deviceMilliseconds(batch.context());
       similarity_->record(batch, *features_, begin, end);
       batch.submit();
       timings_.similarity_ms += msSince(t0);
+      timings_.similarity_kernel_ms += gpu::deviceMilliseconds(batch.context()) - device0;
     }
     ++timings_.attempts;
     if (similarity_->read(pass_candidates, pass_refined)) {

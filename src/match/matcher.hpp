@@ -50,6 +50,9 @@ struct MatchTimings {
   double features_ms = 0;    ///< stage 1: the frame features' submit
   double similarity_ms = 0;  ///< stage 2: the similarity passes' submits (coarse and refinement)
   double finish_ms = 0;   ///< host-side sorting and deduplication
+  /// The GPU's own time within features_ms and similarity_ms (device timestamps; 0 where the
+  /// queue writes none): the rest is recording, submitting, waiting and reading back.
+  double features_kernel_ms = 0, similarity_kernel_ms = 0;
   std::size_t coarse_candidates = 0;
   /// Submits of the similarity stage: 1 unless the candidates outgrew one GPU buffer and
   /// the template chunks were split over several passes.

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "gpu/batch.hpp"
 #include "hypotheses/cluster_score.hpp"
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
@@ -134,13 +135,38 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 
 Detector::~Detector() = default;
 
-void appendMatchTimings(const MatchTimings& t, StageTimings& to) {
-  if (t.upload_ms > 0) to.emplace_back("upload", t.upload_ms);
-  if (t.pairs > 0) to.emplace_back("depth_pruning", t.pruning_ms);
-  to.emplace_back("features", t.features_ms);
-  to.emplace_back("similarity", t.similarity_ms);
-  to.emplace_back("match_readback", t.finish_ms);
+void appendMatchTimings(const MatchTimings& t, DetectionResult& r) {
+  if (t.upload_ms > 0) r.timings_ms.emplace_back("upload", t.upload_ms);
+  if (t.pairs > 0) r.timings_ms.emplace_back("depth_pruning", t.pruning_ms);
+  r.timings_ms.emplace_back("features", t.features_ms);
+  r.timings_ms.emplace_back("similarity", t.similarity_ms);
+  r.timings_ms.emplace_back("match_readback", t.finish_ms);
+  r.kernel_ms.emplace_back("features", t.features_kernel_ms);
+  r.kernel_ms.emplace_back("similarity", t.similarity_kernel_ms);
 }
+
+/// A stage's wall time and the GPU's own time within it (the device time of the submits
+/// waited for meanwhile), added to the result when the stage ends: the rest is the host's.
+class StageClock {
+ public:
+  explicit StageClock(const GpuContext& ctx) : ctx_(ctx) { restart(); }
+  void restart() {
+    wall0_ = std::chrono::steady_clock::now();
+    device0_ = gpu::deviceMilliseconds(ctx_);
+  }
+  /// Ends the stage (less `less_ms` of wall time and `less_kernel_ms` of device time spent in
+  /// a stage timed inside it) and starts the next.
+  void end(const char* stage, DetectionResult& r, double less_ms = 0, double less_kernel_ms = 0) {
+    r.timings_ms.emplace_back(stage, msSince(wall0_) - less_ms);
+    r.kernel_ms.emplace_back(stage, gpu::deviceMilliseconds(ctx_) - device0_ - less_kernel_ms);
+    restart();
+  }
+
+ private:
+  const GpuContext& ctx_;
+  std::chrono::steady_clock::time_point wall0_;
+  double device0_ = 0;
+};
 
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera) {
@@ -190,32 +216,29 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
 
   DetectionResult result;
   result.warnings = focalLengthWarnings(banks_, camera);
-  auto t0 = std::chrono::steady_clock::now();
-  const auto total0 = t0;
+  const auto total0 = std::chrono::steady_clock::now();
   // Started while the previous frame's CPU stages ran (detectSequence), or now.
   std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
-  appendMatchTimings(matcher_->lastTimings(), result.timings_ms);
+  appendMatchTimings(matcher_->lastTimings(), result);
   result.matches = matches.size();
   result.match_pairs = matcher_->lastTimings().pairs;
   result.match_pairs_pruned = matcher_->lastTimings().pairs_pruned;
   result.match_pairs_skipped = matcher_->lastTimings().pairs_skipped;
 
-  t0 = std::chrono::steady_clock::now();
+  StageClock clock(ctx_);
   std::vector<Hypothesis> hypotheses = clusterTemplates(matches, banks_, params_.cluster);
   result.hypotheses = hypotheses.size();
-  result.timings_ms.emplace_back("clustering", msSince(t0));
+  clock.end("clustering", result);
 
-  t0 = std::chrono::steady_clock::now();
   const ScoreScene scene = makeScoreScene(frame.depth_mm, camera);
   scorer_->score(hypotheses, banks_, scene, params_.score);
   const float min_score = params_.estimate_poses ? params_.pose_min_score : params_.min_score;
   std::erase_if(hypotheses, [&](const Hypothesis& h) { return h.best_member < 0 || h.score < min_score; });
   result.scored_hypotheses = hypotheses.size();
-  result.timings_ms.emplace_back("scoring", msSince(t0));
+  clock.end("scoring", result);
 
-  t0 = std::chrono::steady_clock::now();
   hypotheses = nonMaximumSuppression(std::move(hypotheses), banks_, camera.fx, params_);
-  result.timings_ms.emplace_back("nms", msSince(t0));
+  clock.end("nms", result);
 
   // Frames in flight: the GPU is done with this frame (matching, cluster scores), so the next
   // frame's stages 1-2 start there now and run while this frame's CPU stages do. A next frame
@@ -241,36 +264,35 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
                              const cv::Mat& frame_bgr, DetectionResult& result) {
   const PoseFrame frame = poseFrame(scene.camera, scene.depth_m, frame_bgr);
   const unsigned threads = params_.threads;
-  auto t0 = std::chrono::steady_clock::now();
-  const auto wall0 = t0;
+  const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = util::processCpuMs();
+  StageClock clock(ctx_);
   // Stage 6: one or more rotation starts a hypothesis, each rendered and moved onto the scene.
   std::vector<PoseCandidate> candidates = startCandidates(clusters, banks_, frame.camera, params_);
   attachRenderers();
   initialPoses(candidates, objects_, frame, params_);
-  result.timings_ms.emplace_back("initial_pose", msSince(t0));
+  clock.end("initial_pose", result);
   // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).
-  t0 = std::chrono::steady_clock::now();
   smoothSceneCrops(candidates, threads);
-  result.timings_ms.emplace_back("mls", msSince(t0));
-  t0 = std::chrono::steady_clock::now();
+  clock.end("mls", result);
   refineCandidates(candidates, threads);
-  result.timings_ms.emplace_back("icp", msSince(t0));
+  clock.end("icp", result);
   // Stage 8: the collision rate and the depth and outline tests; the poses that pass are
   // rendered against their near-symmetric turns and look-alikes (twins of better ones
   // spared), then accepted or rejected, and the accepted compete for places and the scene.
-  t0 = std::chrono::steady_clock::now();
   verifyCandidates(candidates, frame, threads);
-  const auto symmetries0 = std::chrono::steady_clock::now();
+  StageClock symmetries(ctx_);
   markTwins(candidates, banks_, params_.verify);
   for (auto& c : candidates) resolveNearSymmetries(c, objects_[c.bank()], frame, params_);
   for (auto& c : candidates) resolveLookAlikes(c, objects_[c.bank()], frame, params_);
-  const double symmetries_ms = msSince(symmetries0);
+  DetectionResult symmetries_time;
+  symmetries.end("symmetries", symmetries_time);
   for (const auto& c : candidates)
     if (c.initial.ok) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
   acceptPoses(candidates, banks_, frame.camera, params_, result);
-  result.timings_ms.emplace_back("verification", msSince(t0) - symmetries_ms);
-  result.timings_ms.emplace_back("symmetries", symmetries_ms);
+  clock.end("verification", result, symmetries_time.timings_ms[0].second, symmetries_time.kernel_ms[0].second);
+  result.timings_ms.push_back(symmetries_time.timings_ms[0]);
+  result.kernel_ms.push_back(symmetries_time.kernel_ms[0]);
   result.pose_wall_ms = msSince(wall0);
   result.pose_cpu_ms = util::processCpuMs() - cpu0;
   result.pose_threads = util::threadsFor(candidates.size(), threads);

@@ -18,7 +18,8 @@ Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate&
                   const Camera& camera);
 
 /// Stages 1-2's times under the names the detection JSON reports them by: "upload" (when the
-/// templates were uploaded), "features", "similarity", "match_readback".
-void appendMatchTimings(const MatchTimings& timings, StageTimings& to);
+/// templates were uploaded), "features", "similarity", "match_readback", and the GPU's share
+/// of the first two in kernel_ms.
+void appendMatchTimings(const MatchTimings& timings, DetectionResult& to);
 
 }  // namespace vkpose
