@@ -87,6 +87,19 @@ expect "detect: -q after the subcommand" 0 "$vkpose" detect --bank "$dir/cube.vk
 expect "detect: missing bank file" 1 "$vkpose" detect --bank "$dir/absent.vkpb" "${frame[@]}"
 expect "detect: missing depth image" 1 "$vkpose" detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
   --depth "$dir/absent.png" --camera "$dir/camera.json"
+# Grasp files: one for another object, one with a direction that is not unit length.
+echo '{"object": "mug", "grasps": [{"name": "top", "position_mm": [0, 0, 25], "approach": [0, 0, -1], "opening_mm": 60}]}' \
+  >"$dir/mug.grasps.json"
+echo '{"object": "cube", "grasps": [{"name": "top", "position_mm": [0, 0, 25], "approach": [0, 0, -2], "opening_mm": 60}]}' \
+  >"$dir/long.grasps.json"
+echo '{"object": "cube", "grasps": [{"name": "top", "position_mm": [0, NaN, 25], "approach": [0, 0, -1]}]}' \
+  >"$dir/nan.grasps.json"
+expect "detect: grasps of an object no bank is for" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" \
+  --grasps "$dir/mug.grasps.json"
+expect "detect: a grasp approach that is not unit length" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" \
+  --grasps "$dir/long.grasps.json"
+expect "detect: a grasp file with NaN" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" \
+  --grasps "$dir/nan.grasps.json"
 # Sequences: a folder of frames (rgb/ and depth/) and a list file, one detector for all frames.
 mkdir -p "$dir/seq/rgb" "$dir/seq/depth"
 for n in 000000 000001; do cp "$dir/rgb.png" "$dir/seq/rgb/$n.png"; cp "$dir/depth.png" "$dir/seq/depth/$n.png"; done

@@ -16,7 +16,7 @@ declare -A floor=(
   [hypotheses]=4
   [pose]=5
   [pipeline]=6
-  [io]=7 [eval]=7 [synth]=7
+  [io]=7 [eval]=7 [synth]=7 [pick]=7
   [cli]=8 [python]=8 [bench]=8
 )
 status=0

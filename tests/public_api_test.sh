@@ -19,7 +19,8 @@ done < <(grep -Hn '#include "' "$root"/python/src/*.?pp | grep -Ev '#include "(v
 count=$(ls "$root"/include/vkpose/*.hpp | wc -l)
 echo "include/vkpose: $count public headers"
 # 11: detection.hpp (what the detector finds) is apart from detector.hpp (the Detector) so that
-# the pose stages fill a Detection without seeing the class that runs them.
-if [ "$count" -gt 11 ]; then echo "more than 11 public headers: keep the API small (docs/api.md)"; status=1; fi
+# the pose stages fill a Detection without seeing the class that runs them. 12: picking.hpp
+# (grasps, the bin, the pick list) is a concept of its own, on top of the detections.
+if [ "$count" -gt 12 ]; then echo "more than 12 public headers: keep the API small (docs/api.md)"; status=1; fi
 [ $status -eq 0 ] && echo "public API: ok"
 exit $status

@@ -6,6 +6,7 @@
 // the whole pipeline on three objects built in code, piled in synthetic bins.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "vkpose/device.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/picking.hpp"
 
 namespace vkpose {
 
@@ -150,6 +152,7 @@ struct SynthImage {
   Camera camera;             ///< params.camera, depth_scale 1
   std::vector<int> obj_ids;  ///< per ground-truth instance: 1 + index into the meshes
   std::vector<Pose> poses;   ///< per ground-truth instance: object-to-camera
+  std::optional<BinBox> bin;  ///< the bin layout's bin
 };
 SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
                            int index);

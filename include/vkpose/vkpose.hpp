@@ -11,6 +11,7 @@
 //   detector.hpp    Detector, the detection JSON and overlay pictures
 //   evaluation.hpp  BOP datasets, the paper's metrics, the baselines, runEvaluation
 //   synth.hpp       synthetic BOP datasets and the demo
+//   picking.hpp     bin picking: grasp files, the bin, grasps placed and checked, the pick list
 // Everything under src/ is internal and may change from one commit to the next (docs/api.md).
 #include <string>
 
@@ -23,6 +24,7 @@
 #include "vkpose/evaluation.hpp"
 #include "vkpose/frame.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/picking.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
@@ -11,6 +12,7 @@
 #include "vkpose/config.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
+#include "vkpose/picking.hpp"
 
 namespace vkpose::python {
 
@@ -585,6 +587,51 @@ new HxWx3 uint8 array in the same channel order as rgb (color="bgr" or "rgb").
 
 detections: a Result, or a list of its Detection objects. show_rejected: also the rejected
 hypotheses, in red. depth: the frame's depth, to put beside the colour in false colour.)");
+
+  m.def(
+      "plan_picks",
+      [](const PyResult& result, const py::object& grasps, const py::object& depth, const py::object& bin,
+         const std::string& order, float max_tilt, const py::object& approach_axis) {
+        if (!result.frame) valueError("result: a Result of Detector.detect()");
+        const auto& banks = result.frame->state->detector->banks();
+        PickParams params;
+        params.order = parsePickOrder(order);
+        params.max_tilt_deg = max_tilt;
+        if (!approach_axis.is_none()) params.approach_axis = vector3Of(approach_axis, "approach_axis");
+        std::vector<std::string> files;
+        if (py::isinstance<py::str>(grasps) || py::hasattr(grasps, "__fspath__")) {
+          files.push_back(pathOf(grasps, "grasps"));
+        } else {
+          for (const py::handle h : grasps) files.push_back(pathOf(h, "grasps"));
+        }
+        const std::vector<std::vector<Grasp>> by_bank = graspsForBanks(files, banks, params.symmetry_steps);
+        std::optional<BinBox> box;
+        if (!bin.is_none()) box = loadBin(pathOf(bin, "bin"));
+        const Camera& camera = result.frame->camera;
+        const cv::Mat depth_mm = depthImage(depth, "depth", camera.depth_scale);
+        if (depth_mm.cols != camera.width || depth_mm.rows != camera.height)
+          valueError(fmt::format("depth is {}x{} but the detections are of a {}x{} frame", depth_mm.cols, depth_mm.rows,
+                                 camera.width, camera.height));
+        std::string json;
+        {
+          py::gil_scoped_release nogil;
+          cv::Mat depth_m;
+          depth_mm.convertTo(depth_m, CV_32F, 0.001);
+          json = pickPlanJson(planPicks(result.r.detections, banks, by_bank, depth_m, camera, box, params));
+        }
+        return py::module_::import("json").attr("loads")(json);
+      },
+      py::arg("result"), py::arg("grasps"), py::arg("depth"), py::kw_only(), py::arg("bin") = py::none(),
+      py::arg("order") = "combined", py::arg("max_tilt") = 45.f, py::arg("approach_axis") = py::none(),
+      R"(Bin picking on a Result, as `vkpose detect --grasps` does (docs/picking.md): each grasp file's
+grasps placed at the detections of its object, refused where the gripper would hit the bin, the
+scene or another detection, and the detections ordered into a pick list. Returns {"grasps": [per
+detection {"valid": [...], "refused": [{"name", "reason"}]}], "picks": [{"detection", "grasp",
+"rank", "score", "visible", "height", "reach", "free"}]}, camera frame, metres.
+
+grasps: a grasp file or a list of them. depth: the frame's depth (as detect() took it). bin: a
+bin file. order: combined, height, score or visible. max_tilt: degrees from approach_axis
+(default the camera's viewing direction, (0, 0, 1)).)");
 }
 
 }  // namespace vkpose::python

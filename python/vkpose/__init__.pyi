@@ -254,6 +254,11 @@ def draw(rgb: npt.NDArray[np.uint8], detections: Result | Sequence[Detection], *
          legend: bool = True, depth: npt.NDArray[Any] | None = None, color: str = "bgr") -> npt.NDArray[np.uint8]:
     """The colour image with the detections drawn (a new array)."""
 
+def plan_picks(result: Result, grasps: PathLike | Sequence[PathLike], depth: npt.NDArray[Any], *,
+               bin: PathLike | None = None, order: str = "combined", max_tilt: float = 45.0,
+               approach_axis: Sequence[float] | None = None) -> dict[str, Any]:
+    """Bin picking on a Result: valid and refused grasps per detection, and the pick list."""
+
 def load_frame(rgb: PathLike, depth: PathLike,
                depth_scale: float = 1.0) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint16]]:
     """(bgr, depth in millimetres) as vkpose detect reads them."""

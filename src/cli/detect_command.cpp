@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <fmt/core.h>
@@ -21,6 +22,7 @@
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/frame.hpp"
+#include "vkpose/picking.hpp"
 
 namespace vkpose::cli {
 
@@ -48,7 +50,45 @@ struct DetectOptions {
   double depth_scale = 0;  // 0: the camera file's
   bool force = false;
   DetectorParams params;
+  // Bin picking
+  std::vector<std::string> grasps;
+  std::string bin, pick_order = "combined";
+  PickParams pick;
+  std::vector<float> approach_axis;
 };
+
+/// The pick list of one frame's detections, printed.
+PickPlan planFramePicks(const DetectOptions& opt, const std::vector<std::vector<Grasp>>& grasps,
+                        const std::optional<BinBox>& bin, const std::vector<TemplateBank>& banks,
+                        const DetectionResult& result, const LinemodFrame& frame, const Camera& camera, bool quiet) {
+  cv::Mat depth_m;
+  frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
+  const PickPlan plan = planPicks(result.detections, banks, grasps, depth_m, camera, bin, opt.pick);
+  if (quiet) return plan;
+  fmt::print("pick list ({}): {} of {} detections with a grasp that hits nothing\n", opt.pick_order, plan.picks.size(),
+             result.detections.size());
+  for (std::size_t k = 0; k < plan.picks.size(); ++k) {
+    const Pick& p = plan.picks[k];
+    fmt::print("  {:>2}. detection {} ({}), grasp '{}', tilt {:.0f} deg, rank {:.2f} (score {:.2f}, visible {:.2f}, "
+               "height {:.2f}, reach {:.2f}, free {:.2f})\n",
+               k + 1, p.detection + 1, result.detections[static_cast<std::size_t>(p.detection)].object, p.grasp.name,
+               p.grasp.tilt_deg, p.rank, p.score, p.visible, p.height, p.reach, p.free);
+  }
+  for (std::size_t i = 0; i < plan.detections.size(); ++i)
+    for (const RefusedGrasp& r : plan.detections[i].refused)
+      fmt::print("  detection {}: grasp '{}' refused: {}\n", i + 1, r.name, r.reason);
+  return plan;
+}
+
+/// The detection JSON with each detection's grasps and the pick list in it.
+std::string withPicks(const std::string& detection_json, const PickPlan& plan) {
+  nlohmann::json doc = nlohmann::json::parse(detection_json);
+  const nlohmann::json picks = nlohmann::json::parse(pickPlanJson(plan));
+  for (std::size_t i = 0; i < doc["detections"].size() && i < picks["grasps"].size(); ++i)
+    doc["detections"][i]["grasps"] = picks["grasps"][i];
+  doc["picks"] = picks["picks"];
+  return doc.dump(2) + "\n";
+}
 
 /// One frame of a sequence: its images, the name its outputs take, and its camera.
 struct SequenceFrame {
@@ -244,6 +284,11 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
   const LinemodFrame frame = loadFrame(opt.rgb, opt.depth, camera.depth_scale);
 
   std::vector<TemplateBank> banks = loadBanks(opt.banks, global.quiet);
+  // Grasps and the bin are read and checked before any work.
+  const std::vector<std::vector<Grasp>> grasps = graspsForBanks(opt.grasps, banks, opt.pick.symmetry_steps);
+  std::optional<BinBox> bin;
+  if (!opt.bin.empty()) bin = loadBin(opt.bin);
+  if (!opt.grasps.empty() && !params.estimate_poses) throw InputError("--grasps needs the pose stages (not --no-pose)");
   GpuContext ctx(global.gpu());
   Detector detector(ctx, std::move(banks), params);
   const DetectionResult result = detector.detect(frame, camera);
@@ -281,15 +326,20 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
     for (const auto& [stage, ms] : result.timings_ms) fmt::print(" {} {:.1f}", stage, ms);
     fmt::print("\n");
   }
+  std::optional<PickPlan> plan;
+  if (!opt.grasps.empty())
+    plan = planFramePicks(opt, grasps, bin, detector.banks(), result, frame, withFrameSize(camera, frame), global.quiet);
   if (!opt.out.empty()) {
-    writeTextFile(opt.out, detectionJson(result, {opt.rgb, opt.depth, ctx.device().name}), opt.force);
+    const std::string json = detectionJson(result, {opt.rgb, opt.depth, ctx.device().name});
+    writeTextFile(opt.out, plan ? withPicks(json, *plan) : json, opt.force);
     if (!global.quiet) fmt::print("wrote {}\n", opt.out);
   }
   if (!opt.overlay.empty()) {
     OverlayOptions overlay = opt.overlay_options;
     if (opt.side_by_side) overlay.depth_mm = frame.depth_mm;
-    writeImage(opt.overlay, drawDetections(frame.bgr, result, detector.banks(), withFrameSize(camera, frame), overlay),
-               opt.force);
+    cv::Mat image = drawDetections(frame.bgr, result, detector.banks(), withFrameSize(camera, frame), overlay);
+    if (plan) drawPicks(image, *plan, withFrameSize(camera, frame));
+    writeImage(opt.overlay, image, opt.force);
     if (!global.quiet) fmt::print("wrote {}\n", opt.overlay);
   }
   return kOk;
@@ -410,7 +460,35 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   addConfigOption(sub, opt->config);
   addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
   addStageFlags(sub, p);
-  return [opt, &global]() { return runDetect(*opt, global); };
+  auto* picking = "Bin picking (docs/picking.md)";
+  auto* grasps = sub->add_option("--grasps", opt->grasps,
+                                 "Grasp file (JSON) of an object: its grasps are placed at each detection of it, "
+                                 "checked, and the detections ordered into a pick list; repeat for several objects")
+                     ->excludes(frames)
+                     ->excludes(list)
+                     ->group(picking);
+  sub->add_option("--bin", opt->bin, "The bin (JSON: its pose in the camera frame, inner size, wall thickness)")
+      ->needs(grasps)
+      ->group(picking);
+  sub->add_option("--pick-order", opt->pick_order, "What the pick list is ordered by: combined, height, score, visible")
+      ->check(CLI::IsMember({"combined", "height", "score", "visible"}))
+      ->capture_default_str()
+      ->group(picking);
+  sub->add_option("--max-tilt", opt->pick.max_tilt_deg,
+                  "Grasps whose approach is tilted further than this from the approach axis are refused, degrees")
+      ->check(CLI::Range(1.0, 180.0))
+      ->capture_default_str()
+      ->group(picking);
+  sub->add_option("--approach-axis", opt->approach_axis,
+                  "The robot's approach direction in the camera frame, 3 numbers (default 0 0 1: along the camera's view)")
+      ->expected(3)
+      ->group(picking);
+  return [opt, &global]() {
+    opt->pick.order = parsePickOrder(opt->pick_order);
+    if (!opt->approach_axis.empty())
+      opt->pick.approach_axis = Eigen::Vector3f(opt->approach_axis[0], opt->approach_axis[1], opt->approach_axis[2]);
+    return runDetect(*opt, global);
+  };
 }
 
 }  // namespace vkpose::cli

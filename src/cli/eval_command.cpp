@@ -3,9 +3,12 @@
 // protocol; prints a table, writes a JSON report and BOP results CSVs.
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "cli/distributed_eval.hpp"
@@ -13,6 +16,7 @@
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
+#include "vkpose/picking.hpp"
 
 namespace vkpose::cli {
 
@@ -25,7 +29,47 @@ struct EvalOptions {
   bool force = false;
   EvalRunParams params;
   DaskTarget dask;
+  std::vector<std::string> grasps;  ///< grasp files: check each image's first pick against the truth
+  PickParams pick;
+  std::string pick_order = "combined";
 };
+
+/// The first picks of a run, checked against each image's ground truth.
+struct PickCheck {
+  int frames = 0, ok = 0;
+  std::vector<std::string> problems;  ///< "scene S image I: why"
+};
+
+/// An on_detections callback that plans each image's picks (its bin from SCENE/bin/IMAGE.json
+/// when synth wrote one) and checks the first against the ground truth.
+std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> pickChecker(
+    const EvalOptions& opt, const std::map<int, TemplateBank>& banks, PickCheck& check) {
+  auto bank_list = std::make_shared<std::vector<TemplateBank>>();
+  auto index = std::make_shared<std::map<int, int>>();  // obj_id -> bank index (obj_id order)
+  for (const auto& [obj_id, bank] : banks) (*index)[obj_id] = static_cast<int>(bank_list->size()), bank_list->push_back(bank);
+  auto grasps =
+      std::make_shared<std::vector<std::vector<Grasp>>>(graspsForBanks(opt.grasps, *bank_list, opt.pick.symmetry_steps));
+  const PickParams pick = opt.pick;
+  return [bank_list, index, grasps, pick, &check](const BopImage& im, const LinemodFrame& frame,
+                                                   const DetectionResult& result) {
+    cv::Mat depth_m;
+    frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
+    const auto bin_file = std::filesystem::path(im.rgb_path).parent_path().parent_path() / "bin" /
+                          fmt::format("{:06d}.json", im.image_id);
+    std::optional<BinBox> bin;
+    if (std::filesystem::exists(bin_file)) bin = loadBin(bin_file.string());
+    Camera camera = im.camera;
+    camera.width = frame.depth_mm.cols, camera.height = frame.depth_mm.rows;
+    const PickPlan plan = planPicks(result.detections, *bank_list, *grasps, depth_m, camera, bin, pick);
+    std::vector<TruthInstance> truth;
+    for (const GroundTruthPose& g : im.gt)
+      if (const auto it = index->find(g.obj_id); it != index->end()) truth.push_back({it->second, {g.R, g.t}});
+    const std::string problem = firstPickProblem(plan, result.detections, *bank_list, truth, bin);
+    ++check.frames;
+    if (problem.empty()) ++check.ok;
+    else check.problems.push_back(fmt::format("scene {} image {}: {}", im.scene_id, im.image_id, problem));
+  };
+}
 
 /// "OBJ_ID=BANK" pairs -> obj_id -> bank path.
 std::map<int, std::string> parseBankArgs(const std::vector<std::string>& args) {
@@ -85,10 +129,11 @@ void printPrSummary(const EvalReport& report) {
 }
 
 /// The report of the run: on this process, or spread over Dask's workers.
-EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const EvalRunParams& params) {
+EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const EvalRunParams& params, PickCheck& picks) {
   const BopDataset dataset = loadBopDataset(opt.dataset, opt.split);
   const std::map<int, std::string> bank_paths = parseBankArgs(opt.banks);
   if (opt.dask.workers > 0 || !opt.dask.scheduler.empty()) {
+    if (!opt.grasps.empty()) throw InputError("--grasps checks the picks in this process: leave out --workers/--dask");
     EvalJob job;
     job.dataset = std::filesystem::absolute(opt.dataset).string();
     job.split = opt.split;
@@ -105,10 +150,12 @@ EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const E
   std::map<int, TemplateBank> banks;
   for (const auto& [obj_id, path] : bank_paths) banks.emplace(obj_id, loadBank(path));
   checkBanksAgainstDataset(banks, dataset);
+  EvalRunParams run = params;
+  if (!opt.grasps.empty()) run.on_detections = pickChecker(opt, banks, picks);
   GpuContext ctx(global.gpu());
   ProgressBar bar("evaluating", global.quiet);
   EvalReport report =
-      runEvaluation(ctx, dataset, banks, params, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
+      runEvaluation(ctx, dataset, banks, run, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
   bar.finish();
   return report;
 }
@@ -127,15 +174,28 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
   if (!std::filesystem::is_directory(opt.dataset))
     throw InputError(opt.dataset + ": no such dataset folder");
 
-  const EvalReport report = evaluate(opt, global, params);
+  PickCheck picks;
+  const EvalReport report = evaluate(opt, global, params, picks);
   for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
   fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
              report.images == 1 ? "" : "s", report.dataset, report.split, report.objects.size(),
              report.objects.size() == 1 ? "" : "s", params.eval.k_m, report.device);
   fmt::print("{}", evalReportTable(report));
+  if (!opt.grasps.empty()) {
+    fmt::print("first pick ({}): right and clear in {} of {} images ({:.1f} %)\n", opt.pick_order, picks.ok,
+               picks.frames, picks.frames > 0 ? 100.0 * picks.ok / picks.frames : 0.0);
+    for (const std::string& p : picks.problems) fmt::print("  {}\n", p);
+  }
   if (!opt.report.empty()) {
-    writeTextFile(opt.report, evalReportJson(report), opt.force);
+    std::string json = evalReportJson(report);
+    if (!opt.grasps.empty()) {
+      nlohmann::json doc = nlohmann::json::parse(json);
+      doc["picks"] = {{"order", opt.pick_order}, {"images", picks.frames}, {"first_pick_ok", picks.ok},
+                      {"problems", picks.problems}};
+      json = doc.dump(2) + "\n";
+    }
+    writeTextFile(opt.report, json, opt.force);
     if (!global.quiet) fmt::print("wrote {}\n", opt.report);
   }
   if (!opt.pr_curve.empty()) {
@@ -204,6 +264,19 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->group(spread);
   addConfigOption(sub, opt->config);
   addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  auto* picking = "Bin picking (docs/picking.md)";
+  sub->add_option("--grasps", opt->grasps,
+                  "Grasp file of an object: plan each image's picks (the bin from SCENE/bin/IMAGE.json when synth "
+                  "wrote it) and check the first against the ground truth; repeat for several objects")
+      ->group(picking);
+  sub->add_option("--pick-order", opt->pick_order, "What the pick list is ordered by: combined, height, score, visible")
+      ->check(CLI::IsMember({"combined", "height", "score", "visible"}))
+      ->capture_default_str()
+      ->group(picking);
+  sub->add_option("--max-tilt", opt->pick.max_tilt_deg, "Largest approach tilt from the camera's view, degrees")
+      ->check(CLI::Range(1.0, 180.0))
+      ->capture_default_str()
+      ->group(picking);
   auto* protocol = "Evaluation protocol";
   sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
       ->check(CLI::Range(0.001, 10.0))
@@ -238,7 +311,10 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.02, 1.0))
       ->capture_default_str()
       ->group(methods);
-  return [opt, &global]() { return runEval(*opt, global); };
+  return [opt, &global]() {
+    opt->pick.order = parsePickOrder(opt->pick_order);
+    return runEval(*opt, global);
+  };
 }
 
 }  // namespace vkpose::cli

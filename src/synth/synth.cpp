@@ -7,6 +7,7 @@
 #include <deque>
 #include <filesystem>
 #include <numbers>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -18,6 +19,7 @@
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/picking.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose {
@@ -92,6 +94,7 @@ struct ImageScene {
   int left_out = 0;
   std::deque<Mesh> owned;    ///< table, bin and clutter meshes (a deque: pointers stay valid)
   Pose camera_T_world;
+  std::optional<BinBox> bin;  ///< the bin layout's bin (its frame is the world's)
 
   void add(Mesh mesh, const Pose& world_T_object) {
     owned.push_back(std::move(mesh));
@@ -178,6 +181,9 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
   // Clutter no larger than the parts when they are small (below 10 cm, where it used to dwarf them).
   addClutter(s, p, placement, obstacles, std::min(1.f, diameter / 0.1f), rng);
   if (placement.layout == Layout::Bin) {
+    s.bin = BinBox{s.camera_T_world,
+                   {placement.bin_inner_m.x(), placement.bin_inner_m.y(), placement.bin_wall_height_m},
+                   placement.bin_wall_thickness_m};
     const Eigen::Vector3f colour = randomColour(rng, 0.2f, 0.7f);
     for (const OrientedBox& wall : binWalls(placement)) {
       Pose at;
@@ -456,6 +462,10 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
     summary.instances += static_cast<int>(s.obj_ids.size());
     writeImage((scene_dir / "rgb" / fmt::format("{:06d}.png", i)).string(), frame.bgr, false);
     writeImage((scene_dir / "depth" / fmt::format("{:06d}.png", i)).string(), frame.depth_mm, false);
+    if (s.bin) {  // where the bin is, for `vkpose detect --bin` (not a BOP file)
+      fs::create_directories(scene_dir / "bin");
+      writeTextFile((scene_dir / "bin" / fmt::format("{:06d}.json", i)).string(), binJson(*s.bin), false);
+    }
     if (progress) progress(i + 1, p.images);
   }
   writeTextFile((scene_dir / "scene_gt.json").string(), sceneGtJson(gt), false);
@@ -485,6 +495,7 @@ SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, con
   SynthImage out;
   out.frame = std::move(image.frame);
   out.camera = camera;
+  out.bin = image.scene.bin;
   for (std::size_t i = 0; i < image.scene.obj_ids.size(); ++i) {
     out.obj_ids.push_back(image.scene.obj_ids[i]);
     out.poses.push_back(image.scene.objects[i].pose);

@@ -1,0 +1,443 @@
+// Grasps placed at detections, the gripper swept in and out along its approach and tested
+// against the bin (sampled on the gripper's surface against the bin's slabs) and against
+// points (the other detections' surfaces, the scene's depth points that are not the part
+// itself), then the pick list. docs/picking.md has the frames and the ranking.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "geometry/nearest_neighbours.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/picking.hpp"
+
+namespace vkpose {
+namespace {
+
+float degrees(float rad) { return rad * 180.f / std::numbers::pi_v<float>; }
+
+Eigen::Matrix3f axisAngle(const Eigen::Vector3f& axis, float rad) {
+  return Eigen::AngleAxisf(rad, axis.normalized()).toRotationMatrix();
+}
+
+/// The swept gripper in its own frame: z from -(length + the farther of approach and retreat)
+/// to 0, the envelope's cross-section about z.
+struct SweptGripper {
+  GripperShape shape;
+  float z_min = 0.f;
+
+  explicit SweptGripper(const Grasp& g)
+      : shape(g.gripper), z_min(-(g.gripper.length + std::max(g.approach_m, g.retreat_m))) {}
+
+  /// Distance from a gripper-frame point to the envelope (0 inside).
+  float distance(const Eigen::Vector3f& p) const {
+    const float dz = std::max({0.f, p.z(), z_min - p.z()});
+    float dr = 0.f;
+    if (shape.kind == GripperShape::Kind::Cylinder) {
+      dr = std::max(0.f, std::hypot(p.x(), p.y()) - shape.radius);
+    } else {
+      dr = std::hypot(std::max(0.f, std::abs(p.x()) - shape.size_x / 2), std::max(0.f, std::abs(p.y()) - shape.size_y / 2));
+    }
+    return std::hypot(dr, dz);
+  }
+  float halfWidth() const {
+    return shape.kind == GripperShape::Kind::Cylinder ? shape.radius : 0.5f * std::hypot(shape.size_x, shape.size_y);
+  }
+  /// A bounding sphere in the gripper frame: centre on the axis, radius.
+  std::pair<Eigen::Vector3f, float> sphere() const {
+    const float h = -z_min / 2;
+    return {Eigen::Vector3f(0, 0, -h), std::hypot(h, halfWidth())};
+  }
+  /// Points on the envelope's surface and axis, at most `spacing` apart.
+  std::vector<Eigen::Vector3f> samples(float spacing) const {
+    std::vector<Eigen::Vector3f> out;
+    const int nz = std::max(2, static_cast<int>(std::ceil(-z_min / spacing)) + 1);
+    for (int iz = 0; iz < nz; ++iz) {
+      const float z = z_min * static_cast<float>(iz) / static_cast<float>(nz - 1);
+      out.emplace_back(0.f, 0.f, z);
+      if (shape.kind == GripperShape::Kind::Cylinder) {
+        const int n = std::max(8, static_cast<int>(std::ceil(2 * std::numbers::pi_v<float> * shape.radius / spacing)));
+        for (int k = 0; k < n; ++k) {
+          const float a = 2 * std::numbers::pi_v<float> * static_cast<float>(k) / static_cast<float>(n);
+          out.emplace_back(shape.radius * std::cos(a), shape.radius * std::sin(a), z);
+        }
+      } else {
+        const int nx = std::max(2, static_cast<int>(std::ceil(shape.size_x / spacing)) + 1);
+        const int ny = std::max(2, static_cast<int>(std::ceil(shape.size_y / spacing)) + 1);
+        for (int i = 0; i < nx; ++i)
+          for (int j = 0; j < ny; ++j)
+            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
+              out.emplace_back(shape.size_x * (static_cast<float>(i) / static_cast<float>(nx - 1) - 0.5f),
+                               shape.size_y * (static_cast<float>(j) / static_cast<float>(ny - 1) - 0.5f), z);
+      }
+    }
+    return out;
+  }
+};
+
+/// Which part of the bin a bin-frame point lies in ("" for none): the floor slab under the
+/// inside and the walls, each as thick as the wall.
+std::string binPart(const BinBox& bin, const Eigen::Vector3f& p) {
+  const float hx = bin.inner.x() / 2, hy = bin.inner.y() / 2, h = bin.inner.z(), t = bin.wall_thickness_m;
+  const bool within_outer = std::abs(p.x()) <= hx + t && std::abs(p.y()) <= hy + t;
+  if (!within_outer || p.z() > h) return {};
+  if (p.z() < 0.f) return p.z() >= -t ? "floor" : std::string();
+  if (p.x() > hx) return "wall (+x)";
+  if (p.x() < -hx) return "wall (-x)";
+  if (p.y() > hy) return "wall (+y)";
+  if (p.y() < -hy) return "wall (-y)";
+  return {};
+}
+
+std::string binCollision(const SweptGripper& swept, const Pose& camera_T_gripper, const BinBox& bin) {
+  const Pose bin_T_gripper = compose(invert(bin.pose), camera_T_gripper);
+  const float spacing = std::clamp(bin.wall_thickness_m * 0.7f, 0.002f, 0.008f);
+  for (const Eigen::Vector3f& s : swept.samples(spacing)) {
+    const std::string part = binPart(bin, bin_T_gripper.R * s + bin_T_gripper.t);
+    if (!part.empty()) return "hits the bin's " + part;
+  }
+  return {};
+}
+
+/// The gripper-frame point of a camera-frame point.
+Eigen::Vector3f inGripper(const Pose& gripper_T_camera, const Eigen::Vector3f& p) {
+  return gripper_T_camera.R * p + gripper_T_camera.t;
+}
+
+/// Points on a mesh's surface at most about `spacing` apart (area-weighted, deterministic),
+/// with their faces' normals; object frame.
+void surfacePoints(const Mesh& mesh, float spacing, std::vector<Eigen::Vector3f>& points,
+                   std::vector<Eigen::Vector3f>& normals) {
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    const Eigen::Vector3f a = mesh.vertices[static_cast<std::size_t>(f.x())];
+    const Eigen::Vector3f b = mesh.vertices[static_cast<std::size_t>(f.y())];
+    const Eigen::Vector3f c = mesh.vertices[static_cast<std::size_t>(f.z())];
+    const Eigen::Vector3f cross = (b - a).cross(c - a);
+    const float area = 0.5f * cross.norm();
+    if (!(area > 0.f)) continue;
+    const Eigen::Vector3f n = cross.normalized();
+    // A triangular grid of k rows: about area / (spacing^2 / 2) points.
+    const int k = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.f * area) / spacing)));
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; i + j < k; ++j) {
+        const float u = (static_cast<float>(i) + 1.f / 3) / static_cast<float>(k);
+        const float v = (static_cast<float>(j) + 1.f / 3) / static_cast<float>(k);
+        points.push_back(a + u * (b - a) + v * (c - a));
+        normals.push_back(n);
+      }
+  }
+}
+
+/// A detection's surface in the camera frame.
+struct PlacedPart {
+  std::vector<Eigen::Vector3f> points, normals;
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+  float radius = 0.f;
+};
+
+PlacedPart placePart(const Detection& d, const TemplateBank& bank, float spacing) {
+  PlacedPart part;
+  std::vector<Eigen::Vector3f> points, normals;
+  surfacePoints(bank.mesh, spacing, points, normals);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    part.points.push_back(d.pose.R * points[i] + d.pose.t);
+    part.normals.push_back(d.pose.R * normals[i]);
+  }
+  part.centre = d.pose.R * bank.centre + d.pose.t;
+  part.radius = 0.f;
+  for (const auto& p : part.points) part.radius = std::max(part.radius, (p - part.centre).norm());
+  return part;
+}
+
+/// Share of a part's camera-facing surface that the scene does not hide (its own nearest
+/// surface per pixel, compared with the scene's depth; pixels without depth left out).
+float visibleShare(const PlacedPart& part, const cv::Mat& depth_m, const Camera& camera, float tolerance) {
+  std::vector<std::pair<long, float>> nearest;  // (pixel, depth) of the part's own front
+  for (std::size_t i = 0; i < part.points.size(); ++i) {
+    const Eigen::Vector3f& p = part.points[i];
+    if (p.z() <= 0.f || part.normals[i].dot(p) >= 0.f) continue;
+    const Eigen::Vector2f px = camera.project(p);
+    const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+    if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+    nearest.emplace_back(static_cast<long>(v) * depth_m.cols + u, p.z());
+  }
+  std::sort(nearest.begin(), nearest.end());
+  int seen = 0, hidden = 0;
+  for (std::size_t i = 0; i < nearest.size(); ++i) {
+    if (i > 0 && nearest[i].first == nearest[i - 1].first) continue;  // the nearest sample of each pixel
+    const float scene = depth_m.at<float>(static_cast<int>(nearest[i].first / depth_m.cols),
+                                          static_cast<int>(nearest[i].first % depth_m.cols));
+    if (!(scene > 0.f)) continue;
+    (scene < nearest[i].second - tolerance ? hidden : seen) += 1;
+  }
+  return seen + hidden > 0 ? static_cast<float>(seen) / static_cast<float>(seen + hidden) : 0.f;
+}
+
+/// The scene's depth points near the swept gripper that are not the part itself: how many lie
+/// inside it, and the nearest one's distance to it.
+struct SceneClearance {
+  int inside = 0;
+  float nearest_m = 0.f;
+};
+
+SceneClearance sceneClearance(const SweptGripper& swept, const Pose& camera_T_gripper, const cv::Mat& depth_m,
+                              const Camera& camera, const NearestNeighbours& own, float part_tolerance, float clearance) {
+  SceneClearance out{0, clearance};
+  if (depth_m.empty()) return out;
+  const Pose gripper_T_camera = invert(camera_T_gripper);
+  // The image window of the swept gripper's bounding sphere, grown by the clearance.
+  const auto [centre_g, radius] = swept.sphere();
+  const Eigen::Vector3f c = camera_T_gripper.R * centre_g + camera_T_gripper.t;
+  const float r = radius + clearance;
+  if (c.z() - r <= 0.01f) return out;  // reaches the camera: the window would be the whole image
+  const Eigen::Vector2f px = camera.project(c);
+  const float pr = static_cast<float>(camera.fx) * r / (c.z() - r);
+  const int u0 = std::max(0, static_cast<int>(px.x() - pr)), u1 = std::min(depth_m.cols - 1, static_cast<int>(px.x() + pr));
+  const int v0 = std::max(0, static_cast<int>(px.y() - pr)), v1 = std::min(depth_m.rows - 1, static_cast<int>(px.y() + pr));
+  for (int v = v0; v <= v1; v += 2)
+    for (int u = u0; u <= u1; u += 2) {
+      const float z = depth_m.at<float>(v, u);
+      if (!(z > 0.f)) continue;
+      const Eigen::Vector3f p = camera.backProject(static_cast<float>(u), static_cast<float>(v), z);
+      const float d = swept.distance(inGripper(gripper_T_camera, p));
+      if (d >= out.nearest_m && d > 0.f) continue;
+      float own_sqr = 0.f;
+      if (own.nearest(p, own_sqr) >= 0 && own_sqr <= part_tolerance * part_tolerance) continue;  // the part itself
+      if (d == 0.f) ++out.inside;
+      out.nearest_m = std::min(out.nearest_m, d);
+    }
+  return out;
+}
+
+/// The first of `obstacles` whose points the swept gripper holds, and the nearest point's
+/// distance to it (up to `clearance`).
+std::pair<int, float> pointCollision(const SweptGripper& swept, const Pose& camera_T_gripper,
+                                     const std::vector<const std::vector<Eigen::Vector3f>*>& obstacles, float clearance) {
+  const Pose gripper_T_camera = invert(camera_T_gripper);
+  const auto [centre_g, radius] = swept.sphere();
+  const Eigen::Vector3f c = camera_T_gripper.R * centre_g + camera_T_gripper.t;
+  float nearest = clearance;
+  for (std::size_t k = 0; k < obstacles.size(); ++k)
+    for (const Eigen::Vector3f& p : *obstacles[k]) {
+      if ((p - c).squaredNorm() > (radius + clearance) * (radius + clearance)) continue;
+      const float d = swept.distance(inGripper(gripper_T_camera, p));
+      if (d == 0.f) return {static_cast<int>(k), 0.f};
+      nearest = std::min(nearest, d);
+    }
+  return {-1, nearest};
+}
+
+PlacedGrasp placeGrasp(const Grasp& g, const Pose& object_pose, const Eigen::Vector3f& axis) {
+  PlacedGrasp p;
+  p.name = g.name;
+  p.priority = g.priority;
+  p.pose = compose(object_pose, g.pose);
+  const Eigen::Vector3f z = p.pose.R.col(2);
+  p.approach_point = p.pose.t - g.approach_m * z;
+  p.retreat_point = p.pose.t - g.retreat_m * z;
+  p.tilt_deg = degrees(std::acos(std::clamp(z.dot(axis.normalized()), -1.f, 1.f)));
+  p.opening_m = g.opening_m;
+  p.suction_radius_m = g.suction_radius_m;
+  p.source = g;
+  return p;
+}
+
+float rankOf(const Pick& p, PickOrder order) {
+  switch (order) {
+    case PickOrder::Height: return p.height;
+    case PickOrder::Score: return p.score;
+    case PickOrder::Visible: return p.visible;
+    case PickOrder::Combined: break;
+  }
+  return 0.3f * p.score + 0.25f * p.height + 0.2f * p.visible + 0.15f * p.reach + 0.1f * p.free;
+}
+}  // namespace
+
+std::vector<Grasp> expandBySymmetry(const std::vector<Grasp>& grasps, const TemplateBank& bank, int steps) {
+  std::vector<Pose> turns = {Pose{}};
+  if (bank.symmetric) {
+    // Continuous about the up axis; through a near-symmetry's point on that axis when the
+    // bank found one (the true axis), else through the bank's centre.
+    const Eigen::Vector3f up = bank.params.views.up.normalized();
+    Eigen::Vector3f point = bank.centre;
+    for (const NearSymmetry& s : bank.near_symmetries)
+      if (std::abs(s.axis.normalized().dot(up)) > 0.99f) point = s.point;
+    for (int k = 1; k < std::max(1, steps); ++k) {
+      const Eigen::Matrix3f R = axisAngle(up, 2 * std::numbers::pi_v<float> * static_cast<float>(k) / static_cast<float>(steps));
+      turns.push_back({R, point - R * point});
+    }
+  }
+  for (const NearSymmetry& s : bank.near_symmetries) turns.push_back(s.transform());
+  std::vector<Grasp> out;
+  for (const Grasp& g : grasps)
+    for (const Pose& turn : turns) {
+      Grasp copy = g;
+      copy.pose = compose(turn, g.pose);
+      out.push_back(copy);
+    }
+  return out;
+}
+
+std::string gripperCollision(const Grasp& grasp, const Pose& camera_T_gripper, const std::optional<BinBox>& bin,
+                             const std::vector<std::vector<Eigen::Vector3f>>& obstacles,
+                             const std::vector<std::string>& names) {
+  const SweptGripper swept(grasp);
+  if (bin) {
+    const std::string why = binCollision(swept, camera_T_gripper, *bin);
+    if (!why.empty()) return why;
+  }
+  std::vector<const std::vector<Eigen::Vector3f>*> sets;
+  for (const auto& o : obstacles) sets.push_back(&o);
+  const auto [hit, nearest] = pointCollision(swept, camera_T_gripper, sets, 0.f);
+  (void)nearest;
+  if (hit < 0) return {};
+  return "hits " + (static_cast<std::size_t>(hit) < names.size() ? names[static_cast<std::size_t>(hit)]
+                                                                  : fmt::format("obstacle {}", hit));
+}
+
+PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<TemplateBank>& banks,
+                   const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
+                   const std::optional<BinBox>& bin, const PickParams& params) {
+  if (!depth_m.empty() && depth_m.type() != CV_32F) throw InputError("planPicks: the depth must be metres (CV_32F)");
+  if (!(params.max_tilt_deg > 0.f && params.max_tilt_deg <= 180.f))
+    throw InputError(fmt::format("the largest approach tilt must be in (0, 180] degrees, not {}", params.max_tilt_deg));
+  if (!(params.approach_axis.norm() > 0.f)) throw InputError("the approach axis must not be zero");
+  PickPlan plan;
+  plan.detections.resize(detections.size());
+  // Each detection's surface, about 3 mm apart (small parts 1/30 of their size).
+  std::vector<PlacedPart> parts;
+  for (const Detection& d : detections) {
+    const TemplateBank& bank = banks.at(static_cast<std::size_t>(d.bank));
+    parts.push_back(placePart(d, bank, std::clamp(bank.diameter / 30.f, 0.001f, 0.003f)));
+  }
+  float z_near = 1e9f, z_far = 0.f;
+  for (const PlacedPart& p : parts) z_near = std::min(z_near, p.centre.z()), z_far = std::max(z_far, p.centre.z());
+
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    const Detection& d = detections[i];
+    const auto b = static_cast<std::size_t>(d.bank);
+    if (b >= grasps.size() || grasps[b].empty()) continue;
+    const NearestNeighbours own(parts[i].points, 0.005f);
+    std::vector<const std::vector<Eigen::Vector3f>*> others;
+    std::vector<std::size_t> other_index;
+    for (std::size_t j = 0; j < parts.size(); ++j)
+      if (j != i) others.push_back(&parts[j].points), other_index.push_back(j);
+
+    // Copies of each named grasp, least tilted first; the first that hits nothing is valid.
+    std::map<std::string, std::vector<PlacedGrasp>> copies;
+    std::map<std::string, std::vector<const Grasp*>> sources;
+    std::vector<std::string> order;
+    for (const Grasp& g : grasps[b]) {
+      if (!copies.count(g.name)) order.push_back(g.name);
+      copies[g.name].push_back(placeGrasp(g, d.pose, params.approach_axis));
+      sources[g.name].push_back(&g);
+    }
+    DetectionGrasps& out = plan.detections[i];
+    for (const std::string& name : order) {
+      std::vector<std::size_t> idx(copies[name].size());
+      for (std::size_t k = 0; k < idx.size(); ++k) idx[k] = k;
+      std::stable_sort(idx.begin(), idx.end(),
+                       [&](std::size_t x, std::size_t y) { return copies[name][x].tilt_deg < copies[name][y].tilt_deg; });
+      std::string first_reason;
+      for (const std::size_t k : idx) {
+        PlacedGrasp p = copies[name][k];
+        const Grasp& g = *sources[name][k];
+        std::string why;
+        if (p.tilt_deg > params.max_tilt_deg) {
+          why = fmt::format("approach tilted {:.0f} degrees from the approach axis (at most {:.0f})", p.tilt_deg,
+                            params.max_tilt_deg);
+        } else {
+          const SweptGripper swept(g);
+          if (bin) why = binCollision(swept, p.pose, *bin);
+          if (why.empty()) {
+            const auto [hit, nearest] = pointCollision(swept, p.pose, others, params.clearance_m);
+            if (hit >= 0) {
+              const Detection& o = detections[other_index[static_cast<std::size_t>(hit)]];
+              why = fmt::format("hits detection {} ({})", other_index[static_cast<std::size_t>(hit)], o.object);
+            } else {
+              const SceneClearance scene = sceneClearance(swept, p.pose, depth_m, camera, own, params.part_tolerance_m,
+                                                          params.clearance_m);
+              if (scene.inside >= params.min_blocking_points)
+                why = fmt::format("{} scene points in the gripper's way (something lies on or beside the part)",
+                                  scene.inside);
+              p.clearance_m = std::min(nearest, scene.nearest_m);
+            }
+          }
+        }
+        if (why.empty()) {
+          out.valid.push_back(p);
+          first_reason.clear();
+          break;
+        }
+        if (first_reason.empty()) first_reason = why;
+      }
+      if (!first_reason.empty()) out.refused.push_back({name, first_reason});
+    }
+    std::stable_sort(out.valid.begin(), out.valid.end(), [](const PlacedGrasp& x, const PlacedGrasp& y) {
+      return x.priority != y.priority ? x.priority > y.priority : x.tilt_deg < y.tilt_deg;
+    });
+    if (out.valid.empty()) continue;
+
+    Pick pick;
+    pick.detection = static_cast<int>(i);
+    pick.grasp = out.valid.front();
+    pick.score = std::clamp(d.score, 0.f, 1.f);
+    pick.visible = depth_m.empty() ? 1.f : visibleShare(parts[i], depth_m, camera, 0.01f);
+    if (bin) {
+      const Eigen::Vector3f in_bin = invert(bin->pose).R * parts[i].centre + invert(bin->pose).t;
+      pick.height = std::clamp(in_bin.z() / bin->inner.z(), 0.f, 1.f);
+    } else {
+      pick.height = z_far > z_near ? (z_far - parts[i].centre.z()) / (z_far - z_near) : 1.f;
+    }
+    pick.reach = std::clamp(1.f - pick.grasp.tilt_deg / params.max_tilt_deg, 0.f, 1.f);
+    pick.free = params.clearance_m > 0.f ? std::clamp(pick.grasp.clearance_m / params.clearance_m, 0.f, 1.f) : 1.f;
+    pick.rank = rankOf(pick, params.order);
+    plan.picks.push_back(pick);
+  }
+  std::stable_sort(plan.picks.begin(), plan.picks.end(), [](const Pick& a, const Pick& b) { return a.rank > b.rank; });
+  return plan;
+}
+
+std::string firstPickProblem(const PickPlan& plan, const std::vector<Detection>& detections,
+                             const std::vector<TemplateBank>& banks, const std::vector<TruthInstance>& truth,
+                             const std::optional<BinBox>& bin, float max_error) {
+  if (plan.picks.empty()) return "no pick";
+  const Pick& pick = plan.picks.front();
+  const Detection& d = detections.at(static_cast<std::size_t>(pick.detection));
+  const TemplateBank& bank = banks.at(static_cast<std::size_t>(d.bank));
+  const float spacing = std::clamp(bank.diameter / 30.f, 0.001f, 0.003f);
+  const PlacedPart picked = placePart(d, bank, spacing);
+  // The true instance the detection is: the nearest of its object within max_error (ADI).
+  int matched = -1;
+  float best = max_error * bank.diameter;
+  std::vector<std::vector<Eigen::Vector3f>> others;
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    const TemplateBank& tb = banks.at(static_cast<std::size_t>(truth[k].bank));
+    Detection at;
+    at.pose = truth[k].pose;
+    PlacedPart part = placePart(at, tb, std::clamp(tb.diameter / 30.f, 0.001f, 0.003f));
+    if (truth[k].bank == d.bank && (part.centre - picked.centre).norm() < bank.diameter) {
+      const NearestNeighbours index(part.points, 0.005f);
+      double sum = 0;
+      for (const Eigen::Vector3f& p : picked.points) {
+        float sqr = 0.f;
+        index.nearest(p, sqr);
+        sum += std::sqrt(sqr);
+      }
+      const float adi = static_cast<float>(sum / static_cast<double>(std::max<std::size_t>(picked.points.size(), 1)));
+      if (adi < best) best = adi, matched = static_cast<int>(k);
+    }
+    others.push_back(std::move(part.points));
+    names.push_back(fmt::format("true instance {} ({})", k, tb.object));
+  }
+  if (matched < 0) return fmt::format("detection {} ({}) is no true instance", pick.detection, d.object);
+  others.erase(others.begin() + matched);
+  names.erase(names.begin() + matched);
+  const std::string hit = gripperCollision(pick.grasp.source, pick.grasp.pose, bin, others, names);
+  return hit.empty() ? std::string() : "the gripper " + hit;
+}
+
+}  // namespace vkpose
