@@ -150,6 +150,27 @@ TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
   EXPECT_TRUE(doc.at("picks").at(0).at("grasp").contains("approach_point"));
 }
 
+TEST(Picking, FingersLeaveRoomBesideThePartThatAPalmWouldTake) {
+  // Jaws 10 cm apart under a palm 6 cm in radius; the gripper frame is the camera frame here.
+  Grasp g = parseGrasps(R"({"object": "can", "gripper": {"radius_mm": 60, "length_mm": 150, "finger_length_mm": 60,
+    "finger_width_mm": 20, "finger_thickness_mm": 10}, "grasps": [{"name": "jaws", "position_mm": [0, 0, 0],
+    "approach": [0, 0, 1], "x": [1, 0, 0], "opening_mm": 100}]})",
+                        "jaws.json")
+                  .grasps[0];
+  EXPECT_FLOAT_EQ(g.gripper.finger_length, 0.06f);
+  // Beside the part, between the fingers' planes (y 3 cm, 2 cm back): clear of the fingers.
+  const std::vector<std::vector<Eigen::Vector3f>> beside = {{Eigen::Vector3f(0.f, 0.03f, -0.02f)}};
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, beside, {"a neighbour"}), "");
+  // On a finger's path (x 5.5 cm), or behind the fingers where the palm passes: hit.
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, {{Eigen::Vector3f(0.055f, 0.f, -0.02f)}}, {"a neighbour"}),
+            "hits a neighbour");
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, {{Eigen::Vector3f(0.f, 0.03f, -0.1f)}}, {"a neighbour"}),
+            "hits a neighbour");
+  // Without fingers the palm's cylinder reaches down to the tool centre point.
+  g.gripper.finger_length = 0.f;
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, beside, {"a neighbour"}), "hits a neighbour");
+}
+
 TEST(Picking, TheFirstPickIsCheckedAgainstTheTruth) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);

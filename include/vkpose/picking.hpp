@@ -19,13 +19,17 @@ namespace vkpose {
 /// The gripper's envelope in the gripper frame: +z is the approach direction (into the part),
 /// the origin the tool centre point (where the part is held); the envelope reaches back from
 /// there, z from -length to 0: a cylinder of `radius` about z, or a box `size_x` by `size_y`.
-/// Moving in and out along z, the gripper sweeps this envelope back to the approach distance.
+/// With fingers (finger_length > 0, for jaws), that shape is the palm, from -length to
+/// -finger_length, and two fingers finger_thickness (along x) by finger_width (along y) reach
+/// on from it to z = 0, just outside the grasp's opening on either side. Moving in and out
+/// along z, the gripper sweeps this envelope back by the approach and retreat distances.
 struct GripperShape {
   enum class Kind { Cylinder, Box };
   Kind kind = Kind::Cylinder;
   float radius = 0.02f;
   float size_x = 0.f, size_y = 0.f;
   float length = 0.15f;
+  float finger_length = 0.f, finger_width = 0.02f, finger_thickness = 0.01f;
 };
 
 /// One way to hold the object.

@@ -91,7 +91,13 @@ GripperShape gripperOf(const Reader& r, const GripperShape& base) {
   g.size_x = r.length("size_x", g.size_x);
   g.size_y = r.length("size_y", g.size_y);
   g.length = r.length("length", g.length);
+  g.finger_length = r.length("finger_length", g.finger_length);
+  g.finger_width = r.length("finger_width", g.finger_width);
+  g.finger_thickness = r.length("finger_thickness", g.finger_thickness);
   if (g.length <= 0.f) r.fail("the gripper's length must be positive");
+  if (g.finger_length >= g.length) r.fail("the fingers must be shorter than the gripper");
+  if (g.finger_length > 0.f && (g.finger_width <= 0.f || g.finger_thickness <= 0.f))
+    r.fail("fingers need a positive finger_width and finger_thickness");
   if (g.kind == GripperShape::Kind::Cylinder && g.radius <= 0.f) r.fail("a cylinder gripper needs a positive radius");
   if (g.kind == GripperShape::Kind::Box && (g.size_x <= 0.f || g.size_y <= 0.f))
     r.fail("a box gripper needs positive size_x and size_y");
@@ -122,6 +128,7 @@ Grasp graspOf(const Reader& r, const GripperShape& gripper) {
   if (g.opening_m > 0.f && g.suction_radius_m > 0.f) r.fail("a grasp has jaws (opening) or a suction cup, not both");
   if (g.opening_m == 0.f && g.suction_radius_m == 0.f) r.fail("give the jaws' 'opening' or the 'suction_radius'");
   g.gripper = r.has("gripper") ? gripperOf(Reader(r.at("gripper"), "its gripper"), gripper) : gripper;
+  if (g.suction_radius_m > 0.f) g.gripper.finger_length = 0.f;  // a suction cup has no fingers
   return g;
 }
 

@@ -27,23 +27,42 @@ Eigen::Matrix3f axisAngle(const Eigen::Vector3f& axis, float rad) {
 struct SweptGripper {
   GripperShape shape;
   float z_min = 0.f;
+  float sweep = 0.f;
+  float palm_z_max = 0.f;  ///< the palm's near end: 0 without fingers, else -finger_length
+  float finger_x = 0.f;    ///< the fingers' centres at +-finger_x
 
   explicit SweptGripper(const Grasp& g)
-      : shape(g.gripper), z_min(-(g.gripper.length + std::max(g.approach_m, g.retreat_m))) {}
+      : shape(g.gripper),
+        z_min(-(g.gripper.length + std::max(g.approach_m, g.retreat_m))),
+        sweep(std::max(g.approach_m, g.retreat_m)),
+        palm_z_max(g.opening_m > 0.f ? -g.gripper.finger_length : 0.f),
+        finger_x(0.5f * (g.opening_m + g.gripper.finger_thickness)) {}
+  bool fingers() const { return palm_z_max < 0.f; }
 
-  /// Distance from a gripper-frame point to the envelope (0 inside).
+  /// Distance from a gripper-frame point to the envelope (0 inside): the palm's cross-section
+  /// from z_min to palm_z_max, and the two fingers from -(finger_length + sweep) to 0.
   float distance(const Eigen::Vector3f& p) const {
-    const float dz = std::max({0.f, p.z(), z_min - p.z()});
+    auto span = [](float v, float lo, float hi) { return std::max({0.f, v - hi, lo - v}); };
     float dr = 0.f;
     if (shape.kind == GripperShape::Kind::Cylinder) {
       dr = std::max(0.f, std::hypot(p.x(), p.y()) - shape.radius);
     } else {
       dr = std::hypot(std::max(0.f, std::abs(p.x()) - shape.size_x / 2), std::max(0.f, std::abs(p.y()) - shape.size_y / 2));
     }
-    return std::hypot(dr, dz);
+    float d = std::hypot(dr, span(p.z(), z_min, palm_z_max));
+    if (fingers()) {
+      const float dz = span(p.z(), palm_z_max - sweep, 0.f), dy = span(p.y(), -shape.finger_width / 2, shape.finger_width / 2);
+      for (const float cx : {-finger_x, finger_x}) {
+        const float dx = span(p.x(), cx - shape.finger_thickness / 2, cx + shape.finger_thickness / 2);
+        d = std::min(d, std::sqrt(dx * dx + dy * dy + dz * dz));
+      }
+    }
+    return d;
   }
   float halfWidth() const {
-    return shape.kind == GripperShape::Kind::Cylinder ? shape.radius : 0.5f * std::hypot(shape.size_x, shape.size_y);
+    const float palm =
+        shape.kind == GripperShape::Kind::Cylinder ? shape.radius : 0.5f * std::hypot(shape.size_x, shape.size_y);
+    return fingers() ? std::max(palm, std::hypot(finger_x + shape.finger_thickness / 2, shape.finger_width / 2)) : palm;
   }
   /// A bounding sphere in the gripper frame: centre on the axis, radius.
   std::pair<Eigen::Vector3f, float> sphere() const {
@@ -53,9 +72,22 @@ struct SweptGripper {
   /// Points on the envelope's surface and axis, at most `spacing` apart.
   std::vector<Eigen::Vector3f> samples(float spacing) const {
     std::vector<Eigen::Vector3f> out;
-    const int nz = std::max(2, static_cast<int>(std::ceil(-z_min / spacing)) + 1);
+    const float z_max = palm_z_max;
+    const int nz = std::max(2, static_cast<int>(std::ceil((z_max - z_min) / spacing)) + 1);
+    if (fingers()) {
+      const float z0 = palm_z_max - sweep;
+      const int fz = std::max(2, static_cast<int>(std::ceil(-z0 / spacing)) + 1);
+      const int fy = std::max(2, static_cast<int>(std::ceil(shape.finger_width / spacing)) + 1);
+      for (const float cx : {-finger_x, finger_x})
+        for (int iz = 0; iz < fz; ++iz)
+          for (int iy = 0; iy < fy; ++iy)
+            for (const float sx : {-0.5f, 0.5f})
+              out.emplace_back(cx + sx * shape.finger_thickness,
+                               shape.finger_width * (static_cast<float>(iy) / static_cast<float>(fy - 1) - 0.5f),
+                               z0 * (1.f - static_cast<float>(iz) / static_cast<float>(fz - 1)));
+    }
     for (int iz = 0; iz < nz; ++iz) {
-      const float z = z_min * static_cast<float>(iz) / static_cast<float>(nz - 1);
+      const float z = z_min + (z_max - z_min) * static_cast<float>(iz) / static_cast<float>(nz - 1);
       out.emplace_back(0.f, 0.f, z);
       if (shape.kind == GripperShape::Kind::Cylinder) {
         const int n = std::max(8, static_cast<int>(std::ceil(2 * std::numbers::pi_v<float> * shape.radius / spacing)));
