@@ -20,6 +20,7 @@
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/picking.hpp"
 #include "vkpose/synth.hpp"
 
 using namespace vkpose;
@@ -286,6 +287,22 @@ TEST(Demo, SolvesBinScenesEndToEnd) {
   const EvalSummary& s = report.evaluation.methods.front().summary;
   EXPECT_GE(s.mean.precision, 0.8) << "few false positives";
   EXPECT_GE(s.mean.recall, 0.4);
+
+  // The picks (demo --pick): every scene has one, and its first is a right pose whose suction
+  // gripper hits neither the bin nor another true part.
+  const std::vector<PickPlan> picks = planDemoPicks(report, out.string());
+  ASSERT_EQ(picks.size(), report.images.size());
+  const BopDataset dataset = loadBopDataset((out / "dataset").string());
+  for (std::size_t i = 0; i < picks.size(); ++i) {
+    EXPECT_FALSE(picks[i].picks.empty()) << "scene " << i;
+    const BopImage& im = dataset.images[i];
+    std::vector<TruthInstance> truth;
+    for (const GroundTruthPose& g : im.gt) truth.push_back({g.obj_id - 1, {g.R, g.t}});
+    const auto bin = loadBin((out / "dataset" / "test" / "000001" / "bin" / fmt::format("{:06d}.json", im.image_id)).string());
+    EXPECT_EQ(firstPickProblem(picks[i], report.images[i].result.detections, report.banks, truth, bin), "")
+        << "scene " << i;
+    EXPECT_TRUE(fs::exists(out / "overlays" / fmt::format("{:06d}_picks.png", im.image_id)));
+  }
 
   // A second run replaces its own folder and reads every bank from the cache.
   const DemoReport again = runDemo(test::context(), params);

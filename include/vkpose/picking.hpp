@@ -65,6 +65,12 @@ GraspSet loadGrasps(const std::string& path);
 std::vector<std::vector<Grasp>> graspsForBanks(const std::vector<std::string>& files,
                                                const std::vector<TemplateBank>& banks, int symmetry_steps = 36);
 
+/// Grasps for a part without a grasp file of its own: a suction cup (`suction_radius_m`, on a
+/// gripper `gripper_radius_m` wide) on the middle of each face of the mesh's box, approaching
+/// along the face's inward normal.
+std::vector<Grasp> faceSuctionGrasps(const Mesh& mesh, float suction_radius_m = 0.008f,
+                                     float gripper_radius_m = 0.012f);
+
 /// The grasps and their copies under the object's symmetries: for a symmetric bank (trained
 /// with --symmetric: continuous about its up axis through its centre) `steps` turns about that
 /// axis, and each near-symmetry's turn. Copies keep their grasp's name. Every copy of a grasp

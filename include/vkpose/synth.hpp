@@ -205,6 +205,7 @@ struct DemoReport {
   int instances = 0;  ///< ground-truth instances in all scenes
   double synth_s = 0, train_s = 0, detect_s = 0, total_s = 0;
   std::string overlay_path, json_path, report_path;  ///< the first image's overlay and JSON, the score report
+  std::vector<TemplateBank> banks;  ///< the objects' banks (obj_id order: a detection's bank index)
 };
 
 /// Runs the demo into params.out_dir: meshes/ (the objects, PLY), dataset/ (the bin scenes in
@@ -213,6 +214,11 @@ struct DemoReport {
 /// An out_dir that exists, is not empty and was not written by an earlier demo is an
 /// InputError unless params.overwrite.
 DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallbacks& callbacks = {});
+
+/// `vkpose demo --pick`: each scene's picks, parallel to report.images: the demo's grasps are a
+/// suction cup on the middle of each face of a part's box (faceSuctionGrasps), the bin the one
+/// synth wrote into out_dir's dataset. Writes overlays/NNNNNN_picks.png and _picks.json.
+std::vector<PickPlan> planDemoPicks(const DemoReport& report, const std::string& out_dir);
 
 /// The demo's three objects (a lidded cup, a gable-top carton, an angle bracket with a hole),
 /// built in code, metres, with vertex colours.

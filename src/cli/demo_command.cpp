@@ -1,12 +1,19 @@
 // `vkpose demo [--out DIR]`: the README's main job. Three objects built in code are piled in a
 // bin, trained (banks cached), detected and scored against the known poses; prints what it does
 // and the results, and writes the overlay PNG and the detection JSON.
+#include <algorithm>
+#include <filesystem>
+#include <optional>
+
 #include <fmt/core.h>
 
 #include "bench/bench_support.hpp"
 #include "cli/commands.hpp"
 #include "util/progress.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/detector.hpp"
+#include "vkpose/evaluation.hpp"
+#include "vkpose/picking.hpp"
 #include "vkpose/synth.hpp"
 
 namespace vkpose::cli {
@@ -18,6 +25,7 @@ struct DemoOptions {
   DemoParams params;
   std::string cache = defaultBankCacheDir(), config, write_meshes;
   bool no_cache = false;
+  bool pick = false;
 };
 
 void printDetections(const DemoImageResult& image) {
@@ -44,6 +52,25 @@ void printTimings(const std::vector<DemoImageResult>& images) {
   for (const auto& [stage, v] : stages) line += fmt::format("  {} {:.0f} ms", stage, bench::median(v));
   fmt::print("{}\n", line);
 }
+/// --pick: each scene's pick list, printed (the overlays with the picks drawn are written).
+void printPicks(const DemoReport& report, const std::string& out_dir) {
+  const std::vector<PickPlan> plans = planDemoPicks(report, out_dir);
+  fmt::print("\nPick lists (suction on the middle of each face of a part's box; docs/picking.md):\n");
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const DemoImageResult& image = report.images[i];
+    fmt::print("  scene image {}: {} of {} detections can be picked\n", image.image_id, plans[i].picks.size(),
+               image.result.detections.size());
+    for (std::size_t k = 0; k < plans[i].picks.size(); ++k) {
+      const Pick& p = plans[i].picks[k];
+      fmt::print("    {}. {} (detection {}), grasp '{}', tilt {:.0f} deg, rank {:.2f}\n", k + 1,
+                 image.result.detections[static_cast<std::size_t>(p.detection)].object, p.detection + 1, p.grasp.name,
+                 p.grasp.tilt_deg, p.rank);
+    }
+  }
+  if (!report.images.empty())
+    fmt::print("Wrote {}_picks.png\n",
+               std::filesystem::path(report.images.front().overlay_path).replace_extension().string());
+}
 }  // namespace
 
 Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
@@ -66,6 +93,9 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--no-cache", opt->no_cache, "Train the banks again and do not keep them");
   addConfigOption(sub, opt->config);
   sub->add_flag("--force", p.overwrite, "Replace the demo's outputs in --out even if that folder holds other things");
+  sub->add_flag("--pick", opt->pick,
+                "Also plan the picks of each scene: where a suction cup takes each part, which part first "
+                "(overlays/NNNNNN_picks.png)");
   sub->add_option("--write-meshes", opt->write_meshes,
                   "Only write the three objects as PLY (millimetres) into this folder and stop (assets/meshes is "
                   "made so); --force replaces files there");
@@ -111,6 +141,7 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
                    : "trained",
                report.detect_s);
     fmt::print("Wrote {} (look at this), {}, {}\n", report.overlay_path, report.json_path, report.report_path);
+    if (opt->pick) printPicks(report, params.out_dir);
     return 0;
   };
 }

@@ -165,6 +165,27 @@ GraspSet parseGrasps(const std::string& text, const std::string& source) {
 
 GraspSet loadGrasps(const std::string& path) { return parseGrasps(readText(path, "grasp file"), path); }
 
+std::vector<Grasp> faceSuctionGrasps(const Mesh& mesh, float suction_radius_m, float gripper_radius_m) {
+  static const char* names[] = {"-x face", "+x face", "-y face", "+y face", "-z face", "+z face"};
+  std::vector<Grasp> out;
+  const Eigen::Vector3f centre = mesh.bboxCentre(), half = 0.5f * (mesh.bbox_max - mesh.bbox_min);
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const float sign = side ? 1.f : -1.f;
+      Grasp g;
+      g.name = names[2 * axis + side];
+      const Eigen::Vector3f z = -sign * Eigen::Vector3f::Unit(axis);  // into the part
+      g.pose.R.col(2) = z;
+      g.pose.R.col(0) = z.unitOrthogonal();
+      g.pose.R.col(1) = z.cross(g.pose.R.col(0));
+      g.pose.t = centre + sign * half[axis] * Eigen::Vector3f::Unit(axis);
+      g.suction_radius_m = suction_radius_m;
+      g.gripper.radius = gripper_radius_m;
+      out.push_back(g);
+    }
+  return out;
+}
+
 std::vector<std::vector<Grasp>> graspsForBanks(const std::vector<std::string>& files,
                                                const std::vector<TemplateBank>& banks, int symmetry_steps) {
   std::vector<std::vector<Grasp>> out(banks.size());

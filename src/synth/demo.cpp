@@ -1,8 +1,10 @@
 // `vkpose demo` (demo.hpp): procedural objects piled in a bin, trained, detected and scored.
 #include "vkpose/synth.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -16,6 +18,7 @@
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/picking.hpp"
 
 namespace vkpose {
 
@@ -200,7 +203,38 @@ DemoReport runDemo(GpuContext& ctx, const DemoParams& params, const DemoCallback
     fs::copy_file(report.images.front().json_path, report.json_path, fs::copy_options::overwrite_existing);
   }
   report.total_s = msSince(t_start) / 1e3;
+  for (auto& [obj_id, bank] : banks) report.banks.push_back(std::move(bank));
   return report;
+}
+
+std::vector<PickPlan> planDemoPicks(const DemoReport& report, const std::string& out_dir) {
+  const fs::path out(out_dir);
+  std::vector<std::vector<Grasp>> grasps;
+  for (const TemplateBank& bank : report.banks) grasps.push_back(expandBySymmetry(faceSuctionGrasps(bank.mesh), bank));
+  const BopDataset dataset = loadBopDataset((out / "dataset").string());
+  std::vector<PickPlan> plans;
+  for (const DemoImageResult& image : report.images) {
+    const auto it = std::find_if(dataset.images.begin(), dataset.images.end(),
+                                 [&](const BopImage& im) { return im.image_id == image.image_id; });
+    if (it == dataset.images.end()) throw InputError(fmt::format("{}: no scene image {}", out_dir, image.image_id));
+    const LinemodFrame frame = loadFrame(it->rgb_path, it->depth_path, it->camera.depth_scale);
+    cv::Mat depth_m;
+    frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
+    Camera camera = it->camera;
+    camera.width = frame.depth_mm.cols, camera.height = frame.depth_mm.rows;
+    const fs::path bin_file =
+        fs::path(it->rgb_path).parent_path().parent_path() / "bin" / fmt::format("{:06d}.json", image.image_id);
+    std::optional<BinBox> bin;
+    if (fs::exists(bin_file)) bin = loadBin(bin_file.string());
+    PickPlan plan = planPicks(image.result.detections, report.banks, grasps, depth_m, camera, bin, PickParams{});
+    cv::Mat overlay = drawDetections(frame.bgr, image.result, report.banks, camera);
+    drawPicks(overlay, plan, camera);
+    const std::string stem = fs::path(image.overlay_path).replace_extension().string();
+    writeImage(stem + "_picks.png", overlay, true);
+    writeTextFile(stem + "_picks.json", pickPlanJson(plan), true);
+    plans.push_back(std::move(plan));
+  }
+  return plans;
 }
 
 }  // namespace vkpose
