@@ -298,7 +298,8 @@ TEST(Demo, SolvesBinScenesEndToEnd) {
     const BopImage& im = dataset.images[i];
     std::vector<TruthInstance> truth;
     for (const GroundTruthPose& g : im.gt) truth.push_back({g.obj_id - 1, {g.R, g.t}});
-    const auto bin = loadBin((out / "dataset" / "test" / "000001" / "bin" / fmt::format("{:06d}.json", im.image_id)).string());
+    const std::optional<BinBox> bin = loadSynthBin(im);
+    ASSERT_TRUE(bin) << "synth --layout bin writes each image's bin";
     EXPECT_EQ(firstPickProblem(picks[i], report.images[i].result.detections, report.banks, truth, bin), "")
         << "scene " << i;
     EXPECT_TRUE(fs::exists(out / "overlays" / fmt::format("{:06d}_picks.png", im.image_id)));

@@ -154,6 +154,10 @@ struct SynthImage {
   std::vector<Pose> poses;   ///< per ground-truth instance: object-to-camera
   std::optional<BinBox> bin;  ///< the bin layout's bin
 };
+/// The bin `synth --layout bin` wrote for an image of its dataset (SCENE/bin/IMAGE.json, beside
+/// rgb/ and depth/), when there is one.
+std::optional<BinBox> loadSynthBin(const BopImage& image);
+
 SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
                            int index);
 

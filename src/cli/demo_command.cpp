@@ -3,7 +3,6 @@
 // and the results, and writes the overlay PNG and the detection JSON.
 #include <algorithm>
 #include <filesystem>
-#include <optional>
 
 #include <fmt/core.h>
 

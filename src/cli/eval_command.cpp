@@ -17,6 +17,7 @@
 #include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 #include "vkpose/picking.hpp"
+#include "vkpose/synth.hpp"
 
 namespace vkpose::cli {
 
@@ -54,10 +55,7 @@ std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)
                                                    const DetectionResult& result) {
     cv::Mat depth_m;
     frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
-    const auto bin_file = std::filesystem::path(im.rgb_path).parent_path().parent_path() / "bin" /
-                          fmt::format("{:06d}.json", im.image_id);
-    std::optional<BinBox> bin;
-    if (std::filesystem::exists(bin_file)) bin = loadBin(bin_file.string());
+    const std::optional<BinBox> bin = loadSynthBin(im);
     Camera camera = im.camera;
     camera.width = frame.depth_mm.cols, camera.height = frame.depth_mm.rows;
     const PickPlan plan = planPicks(result.detections, *bank_list, *grasps, depth_m, camera, bin, pick);

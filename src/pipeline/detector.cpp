@@ -154,12 +154,18 @@ class StageClock {
     wall0_ = std::chrono::steady_clock::now();
     device0_ = gpu::deviceMilliseconds(ctx_);
   }
-  /// Ends the stage (less `less_ms` of wall time and `less_kernel_ms` of device time spent in
-  /// a stage timed inside it) and starts the next.
-  void end(const char* stage, DetectionResult& r, double less_ms = 0, double less_kernel_ms = 0) {
-    r.timings_ms.emplace_back(stage, msSince(wall0_) - less_ms);
-    r.kernel_ms.emplace_back(stage, gpu::deviceMilliseconds(ctx_) - device0_ - less_kernel_ms);
+  /// Wall and device milliseconds since the last restart; restarts.
+  std::pair<double, double> split() {
+    const std::pair<double, double> ms{msSince(wall0_), gpu::deviceMilliseconds(ctx_) - device0_};
     restart();
+    return ms;
+  }
+  /// Ends the stage (less `less` wall and device ms spent in a stage timed inside it, as
+  /// split() gave them) and starts the next.
+  void end(const char* stage, DetectionResult& r, std::pair<double, double> less = {0, 0}) {
+    const auto [wall, device] = split();
+    r.timings_ms.emplace_back(stage, wall - less.first);
+    r.kernel_ms.emplace_back(stage, device - less.second);
   }
 
  private:
@@ -285,14 +291,13 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   markTwins(candidates, banks_, params_.verify);
   for (auto& c : candidates) resolveNearSymmetries(c, objects_[c.bank()], frame, params_);
   for (auto& c : candidates) resolveLookAlikes(c, objects_[c.bank()], frame, params_);
-  DetectionResult symmetries_time;
-  symmetries.end("symmetries", symmetries_time);
+  const auto symmetries_ms = symmetries.split();
   for (const auto& c : candidates)
     if (c.initial.ok) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
   acceptPoses(candidates, banks_, frame.camera, params_, result);
-  clock.end("verification", result, symmetries_time.timings_ms[0].second, symmetries_time.kernel_ms[0].second);
-  result.timings_ms.push_back(symmetries_time.timings_ms[0]);
-  result.kernel_ms.push_back(symmetries_time.kernel_ms[0]);
+  clock.end("verification", result, symmetries_ms);
+  result.timings_ms.emplace_back("symmetries", symmetries_ms.first);
+  result.kernel_ms.emplace_back("symmetries", symmetries_ms.second);
   result.pose_wall_ms = msSince(wall0);
   result.pose_cpu_ms = util::processCpuMs() - cpu0;
   result.pose_threads = util::threadsFor(candidates.size(), threads);

@@ -222,10 +222,7 @@ std::vector<PickPlan> planDemoPicks(const DemoReport& report, const std::string&
     frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
     Camera camera = it->camera;
     camera.width = frame.depth_mm.cols, camera.height = frame.depth_mm.rows;
-    const fs::path bin_file =
-        fs::path(it->rgb_path).parent_path().parent_path() / "bin" / fmt::format("{:06d}.json", image.image_id);
-    std::optional<BinBox> bin;
-    if (fs::exists(bin_file)) bin = loadBin(bin_file.string());
+    const std::optional<BinBox> bin = loadSynthBin(*it);
     PickPlan plan = planPicks(image.result.detections, report.banks, grasps, depth_m, camera, bin, PickParams{});
     cv::Mat overlay = drawDetections(frame.bgr, image.result, report.banks, camera);
     drawPicks(overlay, plan, camera);

@@ -477,6 +477,13 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
   return summary;
 }
 
+std::optional<BinBox> loadSynthBin(const BopImage& image) {
+  const fs::path file =
+      fs::path(image.rgb_path).parent_path().parent_path() / "bin" / fmt::format("{:06d}.json", image.image_id);
+  if (!fs::exists(file)) return std::nullopt;
+  return loadBin(file.string());
+}
+
 SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,
                            int index) {
   if (models.empty()) throw InputError("synthesizeImage needs at least one mesh");
