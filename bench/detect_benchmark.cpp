@@ -14,6 +14,7 @@
 #include "match/features.hpp"
 #include "match/matcher.hpp"
 #include "match/opencv_linemod.hpp"
+#include "pipeline/colour_only.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
@@ -139,6 +140,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups
       {"icp", {"icp"}},
       {"verification", {"verification"}},
       {"symmetries", {"symmetries"}},
+      {"edges", {"edges"}},              // colour only: the frame's edge maps
+      {"contour_fit", {"contour_fit"}},  // colour only: stage 7 on the image's edges
   };
   return groups;
 }
@@ -192,9 +195,16 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   report.frames = o.frames;
   report.warmup = o.warmup;
   report.distinct_frames = static_cast<int>(frames.size());
+  if (o.no_depth) {
+    for (BenchFrame& f : frames) f.frame.depth_mm = cv::Mat();  // colour only
+    report.frames_from += ", depth dropped (colour only)";
+  }
 
-  const std::vector<LinemodTemplate> templates = o.run_opencv ? concatenateTemplates(banks) : std::vector<LinemodTemplate>{};
-  const FeatureParams features = banks.front().params.features;
+  std::vector<LinemodTemplate> templates;
+  std::vector<int> colour_ids;
+  if (o.run_opencv) templates = o.no_depth ? colourTemplates(banks, colour_ids) : concatenateTemplates(banks);
+  FeatureParams features = banks.front().params.features;
+  features.use_depth = features.use_depth && !o.no_depth;
   gpu::resetBufferPeak();
   Detector detector(ctx, std::move(banks), o.params);
   report.templates = 0;

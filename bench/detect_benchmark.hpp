@@ -33,6 +33,8 @@ struct DetectBenchOptions {
   /// Also run the frames through Detector::detectSequence (two frames in flight) and report
   /// its frames/s next to the frame-by-frame figure.
   bool in_flight = true;
+  /// Drop the frames' depth: colour-only detection (and cv::linemod on the colour modality).
+  bool no_depth = false;
   DetectorParams params;
 };
 

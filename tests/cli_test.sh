@@ -87,6 +87,11 @@ expect "detect: -q after the subcommand" 0 "$vkpose" detect --bank "$dir/cube.vk
 expect "detect: missing bank file" 1 "$vkpose" detect --bank "$dir/absent.vkpb" "${frame[@]}"
 expect "detect: missing depth image" 1 "$vkpose" detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
   --depth "$dir/absent.png" --camera "$dir/camera.json"
+# Colour only: the same frame without its depth image (a uniform image: nothing found, exit 0).
+expect "detect: a frame without depth (colour only)" 0 "$vkpose" -q detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
+  --camera "$dir/camera.json"
+expect "detect: grasps need depth" 1 "$vkpose" -q detect --bank "$dir/cube.vkpb" --rgb "$dir/rgb.png" \
+  --camera "$dir/camera.json" --grasps "$dir/absent.grasps.json"
 # Grasp files: one for another object, one with a direction that is not unit length.
 echo '{"object": "mug", "grasps": [{"name": "top", "position_mm": [0, 0, 25], "approach": [0, 0, -1], "opening_mm": 60}]}' \
   >"$dir/mug.grasps.json"

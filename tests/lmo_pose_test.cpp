@@ -94,5 +94,52 @@ TEST(LmoPose, FindsTheMostlyVisibleObjectsWithCorrectPosesAndNothingWrong) {
     EXPECT_NE(std::find(stages.begin(), stages.end(), s), stages.end()) << s;
 }
 
+// The same frame with its depth image withheld: colour-only detection (docs/colour_only.md),
+// scored by the mean 2D projection error of the model points (proj2d, 5 px).
+TEST(LmoPose, ColourOnlyPutsTheClearlyVisibleObjectsWithinFivePixels) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const BopImage& image = lmo().images.at(0);
+  const LinemodFrame frame = loadFrame(image.rgb_path, "", image.camera.depth_scale);
+  ASSERT_TRUE(frame.depth_mm.empty());
+  Detector detector(test::context(), lmoBanks());
+  const DetectionResult result = detector.detect(frame, image.camera);
+  const std::map<int, EvalModel> models = loadEvalModels(lmo());
+  // Each object's best proj2d among the detections and the rejected poses: what the fit
+  // reached, and what verification kept.
+  std::map<int, float> reached, kept;
+  auto score = [&](const std::vector<Detection>& ds, std::map<int, float>& best) {
+    for (const Detection& d : ds) {
+      const int id = objectId(d.object);
+      EXPECT_TRUE(d.colour_only) << d.object;
+      for (const GroundTruthPose& gt : image.gt)
+        if (gt.obj_id == id) {
+          const float e = poseError(models.at(id), {id, d.score, d.pose.R, d.pose.t}, gt, PoseErrorType::Proj2D,
+                                    &image.camera);
+          best.emplace(id, e);
+          best[id] = std::min(best[id], e);
+        }
+    }
+  };
+  score(result.detections, kept);
+  score(result.detections, reached);
+  score(result.rejected, reached);
+  int within = 0;
+  for (const auto& [id, e] : kept) {
+    std::printf("  obj %d: kept, proj2d %.1f px\n", id, e);
+    within += e < 5.f;
+  }
+  // The can (5), cat (6) and duck (9) are found within 5 px and kept. The goal is 5 of the 8
+  // (issue 50); the driller, glue and holepuncher get no start close enough to fit from yet.
+  for (int id : {5, 6, 9}) {
+    ASSERT_TRUE(reached.count(id)) << "object " << id << " got no pose";
+    EXPECT_LT(reached[id], 5.f) << "object " << id;
+  }
+  EXPECT_GE(within, 3);
+  std::vector<std::string> stages;
+  for (const auto& [name, ms] : result.timings_ms) stages.push_back(name);
+  for (const char* s : {"edges", "contour_fit", "verification"})
+    EXPECT_NE(std::find(stages.begin(), stages.end(), s), stages.end()) << s;
+}
+
 }  // namespace
 }  // namespace vkpose

@@ -298,6 +298,32 @@ SensorParams sensorProfile(const std::string& name_or_file);
 /// The profile names sensorProfile() knows, the default first.
 std::vector<std::string> sensorProfileNames();
 
+/// Frames without depth (docs/pipeline.md, colour only): stages 1-3 on the colour modality
+/// alone, a similarity score instead of stage 4, then each candidate's template pose fitted
+/// to the image's edges (a directional chamfer fit instead of MLS + ICP) and verified by how
+/// much of its outline meets an edge running along it, and by its colours.
+struct ColourOnlyParams {
+  /// LINEMOD similarity a match needs without depth, percent. Colour gradients alone match
+  /// clutter far more often (LM-O, 8 objects: 2.6 million matches at 80 %, 19 s of similarity
+  /// on lavapipe; 4.5 s at 90 %, the same objects found), but the objects of synthetic scenes,
+  /// whose colours the templates were not trained on, need 80 (F1 0.27 against 0.12 at 90).
+  float threshold = 80.f;
+  /// Hypotheses per object that get a pose (after NMS, best LINEMOD similarity first).
+  int candidates_per_object = 8;
+  /// Rotation starts per hypothesis (its largest groups of template rotations), each fitted;
+  /// the best supported is kept.
+  int starts = 3;
+  /// Canny's hysteresis thresholds on the strongest channel's Sobel magnitude (L2).
+  float canny_low = 40.f, canny_high = 100.f;
+  /// An outline point is supported within this distance of an image edge of its orientation.
+  float edge_tolerance_px = 2.f;
+  /// Share of the outline points that must be supported for a pose to be accepted, 0..1.
+  float min_contour_support = 0.5f;
+  /// Meshes with colours that vary: the rendered chromaticity must agree with the frame's
+  /// this much (-1: off).
+  float min_colour_agreement = 0.f;
+};
+
 struct DetectorParams {
   MatchParams match;
   ClusterParams cluster;
@@ -329,6 +355,7 @@ struct DetectorParams {
   float duplicate_fraction = 0.3f;
   unsigned threads = 0;  ///< CPU threads for the per-hypothesis stages (0: all cores)
   SensorParams sensor;
+  ColourOnlyParams colour_only;
   /// The lengths of stages 7-8 that depend on the object's size and the sensor's noise
   /// (scaledLengths() lists them) follow each object when left at their defaults: the
   /// defaults were tuned on 10-30 cm objects at 0.6-1.2 m, and a 4 cm part needs finer ones.

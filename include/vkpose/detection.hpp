@@ -55,6 +55,12 @@ struct Detection {
   /// shows several colours, a match of the colour itself where it shows one; 1 when not
   /// measured (a mesh without vertex colours, or the test turned off).
   float colour_agreement = 1.f;
+  /// Posed without depth (colour-only frames): the pose was fitted to the image's edges,
+  /// `contour_edges` and `colour_agreement` verified it, and no depth test ran.
+  bool colour_only = false;
+  /// Colour only: of the frame's edge pixels under the pose's mask, the share that the model's
+  /// own edges (outline, colour edges) explain; a pose laid on clutter covers edges it cannot.
+  float explained_edges = 0.f;
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group

@@ -34,8 +34,10 @@ class Detector {
   Detector(const Detector&) = delete;
   Detector& operator=(const Detector&) = delete;
 
-  /// Throws InputError for a frame with no depth or a camera whose principal point lies
-  /// outside it (the image size is the frame's).
+  /// A frame without depth (depth_mm empty) runs colour-only: the colour modality alone,
+  /// poses fitted to the image's edges (ColourOnlyParams); the banks need colour templates.
+  /// Throws InputError for a depth image that is all zero or a camera whose principal point
+  /// lies outside the frame (the image size is the frame's).
   DetectionResult detect(const LinemodFrame& frame, const Camera& camera);
   /// detect() on each frame in turn (cameras[i] for frames[i]) with two frames in flight:
   /// once a frame's GPU stages are done, the next frame's stages 1-2 start on the GPU and run
@@ -59,12 +61,17 @@ class Detector {
   /// when the detector is built)
   std::vector<PoseObject> objects_;
 
+  /// Colour-only frames' matcher (made at the first such frame; src/pipeline/colour_only.hpp).
+  struct ColourOnlyStages;
+  std::unique_ptr<ColourOnlyStages> colour_only_;
+
   const LinemodFrame* in_flight_ = nullptr;  ///< the frame whose stages 1-2 the matcher is running
 
   DetectionResult detectFrame(const LinemodFrame& frame, const Camera& camera, const LinemodFrame* next);
   void estimatePoses(const std::vector<Hypothesis>& clusters, const ScoreScene& scene, const cv::Mat& frame_bgr,
                      DetectionResult& result);
   void attachRenderers();
+  DetectionResult detectColourOnly(const LinemodFrame& frame, const Camera& camera);
 };
 
 // ---- detections to files --------------------------------------------------------------

@@ -151,7 +151,15 @@ enum class PoseErrorType {
   Auto,  ///< ADI for objects whose ModelInfo is symmetric, ADD otherwise
   ADD,   ///< ADD for every object
   ADI,   ///< ADI for every object
+  /// Mean 2D projection distance of the model points under the two poses, pixels, with the
+  /// image's camera: the usual score of colour-only methods (correct under
+  /// EvalParams::proj2d_px, 5 px, whatever the diameter). Blind to depth along the ray.
+  Proj2D,
 };
+
+/// Proj2D: mean distance in pixels between the model points projected under the two poses.
+float proj2dError(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3f& R_est, const Eigen::Vector3f& t_est,
+                  const Eigen::Matrix3f& R_gt, const Eigen::Vector3f& t_gt, const Camera& camera);
 
 /// What scoring one object needs: its info (diameter, symmetry) and its model points.
 struct EvalModel {
@@ -173,12 +181,15 @@ struct EvalParams {
   /// negative when missed, and an estimate matched to one counts as neither a true nor a false
   /// positive. They still take part in the matching. 0 (default) counts every instance.
   float min_visib_fract = 0.f;
+  /// PoseErrorType::Proj2D: an estimate is correct under this many pixels.
+  float proj2d_px = 5.f;
 };
 
 /// ADD or ADI between an estimate and an instance of the same object, as `type` (Auto: from
-/// model.info.symmetric) says. Metres.
+/// model.info.symmetric) says, metres; or Proj2D in pixels, which needs the image's camera
+/// (InputError without it).
 float poseError(const EvalModel& model, const PoseEstimate& est, const GroundTruthPose& gt,
-                PoseErrorType type = PoseErrorType::Auto);
+                PoseErrorType type = PoseErrorType::Auto, const Camera* camera = nullptr);
 
 /// Detections counted over any number of images.
 struct EvalCounts {
@@ -229,7 +240,8 @@ struct ImageEvaluation {
 /// instance names an object without a model, an estimate's R is not a rotation, or its score or
 /// t is not finite.
 ImageEvaluation evaluateImage(const std::vector<PoseEstimate>& estimates, const std::vector<GroundTruthPose>& gt,
-                              const std::map<int, EvalModel>& models, const EvalParams& params = {});
+                              const std::map<int, EvalModel>& models, const EvalParams& params = {},
+                              const Camera* camera = nullptr);
 
 struct ObjectScores {
   double precision = 0, recall = 0, f1 = 0;  ///< 0 where the ratio is 0/0
@@ -384,6 +396,9 @@ struct EvalRunParams {
   EvalParams eval;
   int max_images = 0;  ///< N images of the split from first_image on; 0: all
   int first_image = 0;  ///< the images before this one are left out (a slice of a run)
+  /// Run as if the dataset had no depth images: vkpose detects colour-only (the other
+  /// methods need depth and are refused).
+  bool no_depth = false;
   /// Called with vkpose's result on each image (e.g. to write its overlay and JSON).
   std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> on_detections;
 };

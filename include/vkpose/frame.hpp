@@ -33,7 +33,7 @@ struct FeatureParams {
 void validateFeatureParams(const FeatureParams& params);
 
 /// An RGB-D frame as LINEMOD reads it: 8-bit BGR colour and 16-bit depth in millimetres
-/// (0 = no reading), the same size.
+/// (0 = no reading), the same size. Without depth (depth_mm empty) the detector runs colour-only.
 struct LinemodFrame {
   cv::Mat bgr;       ///< CV_8UC3
   cv::Mat depth_mm;  ///< CV_16UC1
@@ -44,6 +44,7 @@ void validateFrame(const LinemodFrame& frame, const FeatureParams& params);
 
 /// Loads a colour PNG/JPEG (8-bit, 3 channels; grey is expanded) and a 16-bit depth PNG.
 /// depth_scale: millimetres per depth unit (BOP's `depth_scale`); depth is converted to mm.
+/// An empty depth_path reads the colour image alone (a colour-only frame: depth_mm empty).
 /// Throws InputError naming the file when one is missing, unreadable, of the wrong bit depth,
 /// or when the two differ in size.
 LinemodFrame loadFrame(const std::string& rgb_path, const std::string& depth_path, double depth_scale = 1.0);

@@ -184,6 +184,8 @@ py::dict detectionDict(const Detection& d) {
   out["collision_rate"] = tidy(d.collision_rate);
   out["see_through"] = tidy(d.see_through);
   out["depth_fit"] = tidy(d.depth_fit);
+  out["colour_only"] = d.colour_only;
+  out["explained_edges"] = tidy(d.explained_edges);
   out["silhouette_support"] = tidy(d.silhouette_support);
   out["contour_edges"] = tidy(d.contour_edges);
   out["colour_agreement"] = tidy(d.colour_agreement);
@@ -372,6 +374,10 @@ leaves the config as it was.)")
                              "phi; -1 when the pose stages did not run")
       .def_property_readonly("see_through", [](const PyDetection& p) { return tidy(p.d.see_through); })
       .def_property_readonly("depth_fit", [](const PyDetection& p) { return tidy(p.d.depth_fit); })
+      .def_property_readonly("colour_only", [](const PyDetection& p) { return p.d.colour_only; },
+                             "Posed without depth: fitted to the image's edges, no depth test ran")
+      .def_property_readonly("explained_edges", [](const PyDetection& p) { return tidy(p.d.explained_edges); },
+                             "Colour only: share of the frame's edges under the pose's mask that the model's edges explain")
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
       .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
@@ -497,12 +503,14 @@ value}} or a config file path, as `vkpose detect --config`. device: None, an ind
               if (!(scale > 0) || !std::isfinite(scale))
                 valueError(fmt::format("depth_scale: {} is not a positive number of millimetres per unit", scale));
             }
-            frame.depth_mm = depthImage(depth, "depth", scale);
-            if (frame.depth_mm.size() != frame.bgr.size())
+            if (!depth.is_none()) frame.depth_mm = depthImage(depth, "depth", scale);  // None: colour only
+            if (!depth.is_none() && frame.depth_mm.size() != frame.bgr.size())
               valueError(fmt::format("depth is {}x{} but rgb is {}x{} (width x height): they must be the same size, "
                                      "the depth registered to the colour image",
                                      frame.depth_mm.cols, frame.depth_mm.rows, frame.bgr.cols, frame.bgr.rows));
-            validateFrame(frame, state->detector->banks().front().params.features);
+            FeatureParams features = state->detector->banks().front().params.features;
+            features.use_depth = features.use_depth && !frame.depth_mm.empty();
+            validateFrame(frame, features);
             camera.width = frame.bgr.cols;
             camera.height = frame.bgr.rows;
             PyResult out;
@@ -518,7 +526,7 @@ value}} or a config file path, as `vkpose detect --config`. device: None, an ind
 
 rgb: HxWx3 uint8, BGR as OpenCV reads it (color="rgb" for RGB). depth: HxW, uint16 in millimetres
 (times depth_scale) or float32/float64 in metres (0, NaN: no reading), registered to the colour
-image. K: a 3x3 intrinsic matrix, a vkpose.Camera or a camera.json path. depth_scale: millimetres
+image; None: colour-only detection (the banks' colour templates, poses fitted to the image's edges). K: a 3x3 intrinsic matrix, a vkpose.Camera or a camera.json path. depth_scale: millimetres
 per uint16 unit (default: the Camera's depth_scale, or 1 with a matrix).)")
       .def_property_readonly("banks", [](const DetectorState& s) {
         py::list out;

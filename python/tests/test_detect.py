@@ -114,6 +114,21 @@ def test_bad_arrays_are_clear_errors(bracket_bank):
     assert len(det.detect(rgb, depth, K).detections) == 0
 
 
+def test_colour_only_with_depth_none(icbin, icbin_bank):
+    bank, _ = icbin_bank
+    rgb = cv2.imread(str(icbin / "scene2" / "rgb" / "0000.png"))
+    det = vkpose.Detector([bank])
+    result = det.detect(rgb, None, vkpose.Camera.load(icbin / "camera.json"))
+    assert set(result.timings_ms) >= {"features", "similarity", "edges", "contour_fit", "verification"}
+    assert result.matches > 0
+    for d in list(result.detections) + list(result.rejected):
+        assert d.colour_only and d.to_dict()["colour_only"]
+        assert 0.0 <= d.explained_edges <= 1.0
+    doc = json.loads(result.to_json())
+    assert doc["depth"] == ""
+    assert all(d["colour_only"] for d in doc["detections"])
+
+
 def synthetic_frame(bank_mesh, seed):
     return vkpose.synth_frame(bank_mesh, seed=seed, instances=2, clutter=2, units="mm")
 

@@ -70,6 +70,9 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
                   "CPU threads for the pose stages (0: every core); results are the same for any count")
       ->capture_default_str();
   sub->add_flag("!--no-opencv", options->run_opencv, "Skip the cv::linemod baseline");
+  sub->add_flag("--no-depth", options->no_depth,
+                "Drop the frames' depth images: colour-only detection, stage times of that path (cv::linemod on "
+                "colour gradients alone)");
   sub->add_flag("!--no-depth-pruning", options->params.match.depth_pruning,
                 "Score every template at every position (the matcher before depth-guided pruning), to compare");
   sub->add_flag("!--no-in-flight", options->in_flight,

@@ -279,6 +279,8 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
   if (!opt.frames.empty() || !opt.list.empty()) return runSequence(opt, params, global);
   for (const std::string* path : {&opt.out, &opt.overlay})
     if (!path->empty()) checkWritable(*path, opt.force);
+  if (!opt.grasps.empty() && opt.depth.empty())
+    throw InputError("--grasps needs a depth image (--depth): grasps are checked against the scene's points");
   Camera camera = loadCamera(opt.camera, opt.camera_entry);
   if (opt.depth_scale > 0) camera.depth_scale = opt.depth_scale;
   const LinemodFrame frame = loadFrame(opt.rgb, opt.depth, camera.depth_scale);
@@ -294,10 +296,14 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
   const DetectionResult result = detector.detect(frame, camera);
   for (const auto& w : result.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
-  fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
-             result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
-             result.scored_hypotheses,
-             params.estimate_poses ? params.pose_min_score : params.min_score, ctx.device().name);
+  if (frame.depth_mm.empty())
+    fmt::print("{} detection{} colour only ({} matches, {} hypotheses) on {}\n", result.detections.size(),
+               result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses, ctx.device().name);
+  else
+    fmt::print("{} detection{} ({} matches, {} hypotheses, {} scored above {:.2f}) on {}\n", result.detections.size(),
+               result.detections.size() == 1 ? "" : "s", result.matches, result.hypotheses,
+               result.scored_hypotheses, params.estimate_poses ? params.pose_min_score : params.min_score,
+               ctx.device().name);
   if (global.verbose && result.match_pairs > 0)
     fmt::print("depth-guided pruning: {:.1f} % of {} (template, position) pairs pruned, {:.1f} % skipped unread\n",
                100.0 * static_cast<double>(result.match_pairs_pruned) / static_cast<double>(result.match_pairs),
@@ -429,8 +435,9 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   auto* list = input->add_option("--list", opt->list,
                                  "Text file of a frame sequence: a colour and a depth image path per line");
   input->require_option(1);
-  auto* depth = sub->add_option("--depth", opt->depth, "Depth image (16-bit PNG, aligned to the colour image)");
-  rgb->needs(depth);
+  auto* depth = sub->add_option("--depth", opt->depth,
+                                "Depth image (16-bit PNG, aligned to the colour image); without it, colour-only detection "
+                                "(the banks' colour templates, poses fitted to the image's edges)");
   depth->needs(rgb);
   depth->excludes(frames)->excludes(list);
   auto* camera_opt = sub->add_option("--camera", opt->camera,

@@ -167,7 +167,10 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
   if (!opt.methods.empty()) {
     params.methods.clear();
     for (const auto& m : opt.methods) params.methods.push_back(parseEvalMethod(m));
+  } else if (params.no_depth) {
+    params.methods = {EvalMethod::Vkpose};  // the baselines need depth
   }
+  if (params.no_depth && !opt.grasps.empty()) throw InputError("--grasps needs depth (not --no-depth)");
   checkOutputs(opt, params.methods);
   if (!std::filesystem::is_directory(opt.dataset))
     throw InputError(opt.dataset + ": no such dataset folder");
@@ -176,9 +179,12 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
   const EvalReport report = evaluate(opt, global, params, picks);
   for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
-  fmt::print("{} image{} of {} ({}), {} object{}, k_m {:.2f}, on {}\n", report.images,
-             report.images == 1 ? "" : "s", report.dataset, report.split, report.objects.size(),
-             report.objects.size() == 1 ? "" : "s", params.eval.k_m, report.device);
+  const std::string criterion = params.eval.error == PoseErrorType::Proj2D
+                                    ? fmt::format("proj2d under {:.1f} px", params.eval.proj2d_px)
+                                    : fmt::format("k_m {:.2f}", params.eval.k_m);
+  fmt::print("{} image{} of {} ({}{}), {} object{}, {}, on {}\n", report.images, report.images == 1 ? "" : "s",
+             report.dataset, report.split, params.no_depth ? ", without depth" : "", report.objects.size(),
+             report.objects.size() == 1 ? "" : "s", criterion, report.device);
   fmt::print("{}", evalReportTable(report));
   if (!opt.grasps.empty()) {
     fmt::print("first pick ({}): right and clear in {} of {} images ({:.1f} %)\n", opt.pick_order, picks.ok,
@@ -279,6 +285,23 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
       ->check(CLI::Range(0.001, 10.0))
       ->capture_default_str()
+      ->group(protocol);
+  const std::map<std::string, PoseErrorType> metrics{{"auto", PoseErrorType::Auto},
+                                                     {"add", PoseErrorType::ADD},
+                                                     {"adi", PoseErrorType::ADI},
+                                                     {"proj2d", PoseErrorType::Proj2D}};
+  sub->add_option("--metric", p.eval.error,
+                  "Pose error: auto (ADI for symmetric objects, ADD otherwise), add, adi, or proj2d (mean 2D "
+                  "projection error of the model points, correct under --proj2d-px; the usual colour-only score)")
+      ->transform(CLI::CheckedTransformer(metrics, CLI::ignore_case))
+      ->default_str("auto")
+      ->group(protocol);
+  sub->add_option("--proj2d-px", p.eval.proj2d_px, "With --metric proj2d: an estimate is correct under this many pixels")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str()
+      ->group(protocol);
+  sub->add_flag("--no-depth", p.no_depth,
+                "Ignore the dataset's depth images: vkpose detects colour-only (the baselines need depth)")
       ->group(protocol);
   sub->add_option("--min-visib", p.eval.min_visib_fract,
                   "Instances less visible than this (visib_fract) are neither missed nor found")

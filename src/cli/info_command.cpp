@@ -52,6 +52,12 @@ void printBankSummary(const TemplateBank& bank, const std::string& path) {
              p.features.use_depth ? "depth" : "",
              bank.templates.empty() ? 0.0 : static_cast<double>(features) / static_cast<double>(bank.templates.size()));
   fmt::print("camera: fx {:.2f} fy {:.2f}\n", p.camera.fx, p.camera.fy);
+  // Which frames it serves: RGB-D needs the modalities it was trained with; colour only
+  // needs colour templates (docs/colour_only.md).
+  fmt::print("detects in: {}\n", p.features.use_colour && p.features.use_depth
+                                      ? "RGB-D frames and colour-only frames (without depth: colour templates alone)"
+                                  : p.features.use_colour ? "RGB-D and colour-only frames (colour templates)"
+                                                          : "RGB-D frames only (no colour modality: not colour-only frames)");
   printNearSymmetries(bank);
 }
 }  // namespace

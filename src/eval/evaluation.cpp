@@ -107,6 +107,11 @@ Evaluator::Evaluator(GpuContext& ctx, BopDataset dataset, const std::map<int, Te
   if (params.methods.empty()) throw InputError("no method to evaluate");
   const std::set<EvalMethod> unique(params.methods.begin(), params.methods.end());
   if (unique.size() != params.methods.size()) throw InputError("a method is asked for twice");
+  if (params.no_depth)
+    for (EvalMethod m : params.methods)
+      if (m != EvalMethod::Vkpose)
+        throw InputError(fmt::format("the {} baseline needs depth: without depth evaluate vkpose alone (--method vkpose)",
+                                     methodName(m)));
   const bool needs_banks = unique.count(EvalMethod::Vkpose) || unique.count(EvalMethod::Linemod);
   if (needs_banks && banks.empty())
     throw InputError("vkpose and linemod need a template bank per object: --bank OBJ_ID=BANK");
@@ -181,7 +186,7 @@ void scoreImage(const Evaluator::State& s, MethodRun& run, const BopImage& im,
   for (const auto& g : im.gt)
     if (s.models.count(g.obj_id)) gt.push_back(g);
   try {
-    const ImageEvaluation evaluation = evaluateImage(estimates, gt, s.models, s.params.eval);
+    const ImageEvaluation evaluation = evaluateImage(estimates, gt, s.models, s.params.eval, &im.camera);
     for (const auto& [obj_id, c] : evaluation.counts) run.counts[obj_id] += c;
     for (const auto& [obj_id, v] : evaluation.by_visibility) run.by_visibility[obj_id] += v;
     for (std::size_t e = 0; e < estimates.size(); ++e)
@@ -231,7 +236,7 @@ EvalReport Evaluator::run(std::size_t first, std::size_t count, const EvalProgre
     const BopImage& im = s.dataset.images[i];
     LinemodFrame frame;
     try {
-      frame = loadFrame(im.rgb_path, im.depth_path, im.camera.depth_scale);
+      frame = loadFrame(im.rgb_path, s.params.no_depth ? std::string() : im.depth_path, im.camera.depth_scale);
     } catch (const InputError& e) {  // one bad file does not end a long run: it is named in the report
       report.skipped.push_back({im.scene_id, im.image_id, e.what()});
       step += runs.size();

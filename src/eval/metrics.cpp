@@ -27,14 +27,36 @@ std::map<int, EvalModel> loadEvalModels(const BopDataset& dataset) {
   return out;
 }
 
-float poseError(const EvalModel& model, const PoseEstimate& est, const GroundTruthPose& gt, PoseErrorType type) {
+float proj2dError(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3f& R_est, const Eigen::Vector3f& t_est,
+                  const Eigen::Matrix3f& R_gt, const Eigen::Vector3f& t_gt, const Camera& camera) {
+  if (points.empty()) return 0.f;
+  double sum = 0;
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector3f a = R_est * p + t_est, b = R_gt * p + t_gt;
+    // A point at or behind the camera has no projection: count it as far off the image.
+    if (!(a.z() > 1e-6f) || !(b.z() > 1e-6f)) {
+      sum += 1e4;
+      continue;
+    }
+    sum += (camera.project(a) - camera.project(b)).norm();
+  }
+  return static_cast<float>(sum / static_cast<double>(points.size()));
+}
+
+float poseError(const EvalModel& model, const PoseEstimate& est, const GroundTruthPose& gt, PoseErrorType type,
+                const Camera* camera) {
+  if (type == PoseErrorType::Proj2D) {
+    if (!camera) throw InputError("the 2D projection error needs the image's camera");
+    return proj2dError(model.points.points(), est.R, est.t, gt.R, gt.t, *camera);
+  }
   if (type == PoseErrorType::Auto) type = model.info.symmetric ? PoseErrorType::ADI : PoseErrorType::ADD;
   return type == PoseErrorType::ADI ? adiError(model.points, est.R, est.t, gt.R, gt.t)
                                     : addError(model.points.points(), est.R, est.t, gt.R, gt.t);
 }
 
 ImageEvaluation evaluateImage(const std::vector<PoseEstimate>& estimates, const std::vector<GroundTruthPose>& gt,
-                              const std::map<int, EvalModel>& models, const EvalParams& params) {
+                              const std::map<int, EvalModel>& models, const EvalParams& params,
+                              const Camera* camera) {
   const auto modelOf = [&](int obj_id, const char* what, std::size_t index) -> const EvalModel& {
     const auto it = models.find(obj_id);
     if (it == models.end())
@@ -63,12 +85,13 @@ ImageEvaluation evaluateImage(const std::vector<PoseEstimate>& estimates, const 
   for (const std::size_t e : order) {
     const PoseEstimate& est = estimates[e];
     const EvalModel& model = models.at(est.obj_id);
-    const float threshold = params.k_m * model.info.diameter;
+    const float threshold =
+        params.error == PoseErrorType::Proj2D ? params.proj2d_px : params.k_m * model.info.diameter;
     int best = -1;
     float best_error = 0.f;
     for (std::size_t g = 0; g < gt.size(); ++g) {
       if (taken[g] || gt[g].obj_id != est.obj_id) continue;
-      const float err = poseError(model, est, gt[g], params.error);
+      const float err = poseError(model, est, gt[g], params.error, camera);
       if (err < threshold && (best < 0 || err < best_error)) {
         best = static_cast<int>(g);
         best_error = err;

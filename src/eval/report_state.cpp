@@ -100,15 +100,16 @@ const char* errorName(PoseErrorType type) {
   switch (type) {
     case PoseErrorType::ADD: return "add";
     case PoseErrorType::ADI: return "adi";
+    case PoseErrorType::Proj2D: return "proj2d";
     case PoseErrorType::Auto: break;
   }
   return "auto";
 }
 
 PoseErrorType parseErrorName(const std::string& name) {
-  for (PoseErrorType t : {PoseErrorType::Auto, PoseErrorType::ADD, PoseErrorType::ADI})
+  for (PoseErrorType t : {PoseErrorType::Auto, PoseErrorType::ADD, PoseErrorType::ADI, PoseErrorType::Proj2D})
     if (name == errorName(t)) return t;
-  throw InputError(fmt::format("unknown pose error '{}': auto, add or adi", name));
+  throw InputError(fmt::format("unknown pose error '{}': auto, add, adi or proj2d", name));
 }
 }  // namespace
 
@@ -218,7 +219,9 @@ std::string evalJobJson(const EvalJob& job) {
       {"linemod",
        {{"depth_offset", job.params.linemod.depth_offset}, {"max_per_object", job.params.linemod.max_per_object}}},
       {"ppf", ppf},
-      {"eval", {{"k_m", e.k_m}, {"error", errorName(e.error)}, {"min_visib_fract", e.min_visib_fract}}}};
+      {"no_depth", job.params.no_depth},
+      {"eval",
+       {{"k_m", e.k_m}, {"error", errorName(e.error)}, {"min_visib_fract", e.min_visib_fract}, {"proj2d_px", e.proj2d_px}}}};
   return doc.dump(2) + "\n";
 }
 
@@ -247,6 +250,8 @@ EvalJob parseEvalJob(const std::string& text) {
     p.eval.k_m = e.at("k_m").get<float>();
     p.eval.error = parseErrorName(e.at("error").get<std::string>());
     p.eval.min_visib_fract = e.at("min_visib_fract").get<float>();
+    p.eval.proj2d_px = e.at("proj2d_px").get<float>();
+    p.no_depth = doc.at("no_depth").get<bool>();
     return job;
   } catch (const json::exception& e) {
     throw InputError(fmt::format("an evaluation job that cannot be read: {}", e.what()));

@@ -77,6 +77,13 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision
     j["icp_iterations"] = d.icp_iterations;
     j["rotation_votes"] = d.rotation_votes;
+  } else if (d.colour_only) {  // fitted to the image's edges: no depth test ran
+    j["colour_only"] = true;
+    j["contour_edges"] = round(d.contour_edges, 4);
+    j["explained_edges"] = round(d.explained_edges, 4);
+    j["colour_agreement"] = round(d.colour_agreement, 4);
+    j["contour_iterations"] = d.icp_iterations;
+    j["rotation_votes"] = d.rotation_votes;
   }
   j["verified"] = d.verified;
   j["templates"] = d.templates;
@@ -175,7 +182,7 @@ void drawLabel(cv::Mat& out, const std::string& label, cv::Point org, const cv::
 void drawDetection(cv::Mat& out, const Detection& d, const TemplateBank* bank, const Camera& camera,
                    const cv::Scalar& colour, const std::string& label) {
   const cv::Rect box(cvRound(d.bbox.x), cvRound(d.bbox.y), cvRound(d.bbox.width), cvRound(d.bbox.height));
-  const bool posed = d.collision_rate >= 0.f && bank && !bank->mesh.faces.empty();
+  const bool posed = (d.collision_rate >= 0.f || d.colour_only) && bank && !bank->mesh.faces.empty();
   if (!posed) {
     cv::rectangle(out, box, colour, 2, cv::LINE_AA);
     cv::drawMarker(out, cv::Point(cvRound(d.x), cvRound(d.y)), colour, cv::MARKER_CROSS, 10, 2, cv::LINE_AA);

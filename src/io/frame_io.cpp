@@ -31,6 +31,7 @@ LinemodFrame loadFrame(const std::string& rgb_path, const std::string& depth_pat
   else if (colour.channels() == 4) cv::cvtColor(colour, colour, cv::COLOR_BGRA2BGR);
   else if (colour.channels() != 3) throw InputError("colour image '" + rgb_path + "' has an unsupported channel count");
   f.bgr = colour;
+  if (depth_path.empty()) return f;  // colour only
   cv::Mat depth = readImage(depth_path, ImageChannels::Grey, "depth");
   if (depth.type() != CV_16UC1)
     throw InputError("depth image '" + depth_path + "' must be a 16-bit single-channel PNG");

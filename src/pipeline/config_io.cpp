@@ -54,6 +54,22 @@ std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
       {"detector", "duplicate_fraction", "poses closer than this share of the diameter are one, 0..1",
        &p.duplicate_fraction},
       {"detector", "threads", "CPU threads for the pose stages (0: all cores)", &p.threads},
+      {"colour_only", "threshold", "frames without depth: LINEMOD similarity a match needs, percent",
+       &p.colour_only.threshold},
+      {"colour_only", "candidates_per_object", "frames without depth: hypotheses per object that get a pose",
+       &p.colour_only.candidates_per_object},
+      {"colour_only", "starts", "frames without depth: rotation starts fitted per hypothesis, the best kept",
+       &p.colour_only.starts},
+      {"colour_only", "canny_low", "frames without depth: Canny's low threshold (Sobel magnitude)",
+       &p.colour_only.canny_low},
+      {"colour_only", "canny_high", "frames without depth: Canny's high threshold (Sobel magnitude)",
+       &p.colour_only.canny_high},
+      {"colour_only", "edge_tolerance_px", "frames without depth: an outline point within this of an edge along it is supported, pixels",
+       &p.colour_only.edge_tolerance_px},
+      {"colour_only", "min_contour_support", "frames without depth: share of the outline a pose needs supported, 0..1",
+       &p.colour_only.min_contour_support},
+      {"colour_only", "min_colour_agreement", "frames without depth, meshes with colours: rendered and seen chromaticity must agree this much (-1: off)",
+       &p.colour_only.min_colour_agreement},
   };
 }
 

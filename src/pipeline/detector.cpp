@@ -11,6 +11,7 @@
 #include "hypotheses/cluster_score.hpp"
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
+#include "pipeline/colour_only.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pose/accept.hpp"
 #include "pose/alternatives.hpp"
@@ -61,20 +62,6 @@ std::vector<PoseObject> poseObjects(const std::vector<TemplateBank>& banks, cons
   return objects;
 }
 
-/// A warning for each bank trained for another focal length than the camera's (by over 10 %).
-std::vector<std::string> focalLengthWarnings(const std::vector<TemplateBank>& banks, const Camera& camera) {
-  std::vector<std::string> warnings;
-  for (const auto& b : banks) {
-    const double f_bank = 0.5 * (b.params.camera.fx + b.params.camera.fy), f = 0.5 * (camera.fx + camera.fy);
-    if (std::abs(f / f_bank - 1.0) > 0.1)
-      warnings.push_back(fmt::format(
-          "bank '{}' was trained for a focal length of {:.0f} px, this camera has {:.0f} px: templates are "
-          "scale-specific, so retrain it with this camera (vkpose train --camera)",
-          b.object, f_bank, f));
-  }
-  return warnings;
-}
-
 /// Stage 5. With poses: NMS within each object, then the best few of each object (see
 /// pose_min_score), objects competing after verification, in 3D; and a runner-up rides with
 /// each survivor that gets a pose. Without: one hypothesis a place for all (no verification
@@ -99,20 +86,6 @@ std::vector<Hypothesis> nonMaximumSuppression(std::vector<Hypothesis> hypotheses
   });
   for (auto& h : runnersUp(all, hypotheses, banks, fx, nms)) hypotheses.push_back(std::move(h));
   return hypotheses;
-}
-
-/// Without stages 6-8: each hypothesis at its best template's pose (templatePose).
-std::vector<Detection> templateDetections(const std::vector<Hypothesis>& hypotheses,
-                                          const std::vector<TemplateBank>& banks, const Camera& camera) {
-  std::vector<Detection> detections;
-  for (const auto& h : hypotheses) {
-    Detection d = hypothesisDetection(h, banks);
-    const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
-    const BankTemplate& t = bank.templates[static_cast<std::size_t>(d.template_index)];
-    d.pose = templatePose(h, h.member_scores[static_cast<std::size_t>(h.best_member)], t, bank, camera);
-    detections.push_back(std::move(d));
-  }
-  return detections;
 }
 
 }  // namespace
@@ -145,34 +118,33 @@ void appendMatchTimings(const MatchTimings& t, DetectionResult& r) {
   r.kernel_ms.emplace_back("similarity", t.similarity_kernel_ms);
 }
 
-/// A stage's wall time and the GPU's own time within it (the device time of the submits
-/// waited for meanwhile), added to the result when the stage ends: the rest is the host's.
-class StageClock {
- public:
-  explicit StageClock(const GpuContext& ctx) : ctx_(ctx) { restart(); }
-  void restart() {
-    wall0_ = std::chrono::steady_clock::now();
-    device0_ = gpu::deviceMilliseconds(ctx_);
+/// A warning for each bank trained for another focal length than the camera's (by over 10 %).
+std::vector<std::string> focalLengthWarnings(const std::vector<TemplateBank>& banks, const Camera& camera) {
+  std::vector<std::string> warnings;
+  for (const auto& b : banks) {
+    const double f_bank = 0.5 * (b.params.camera.fx + b.params.camera.fy), f = 0.5 * (camera.fx + camera.fy);
+    if (std::abs(f / f_bank - 1.0) > 0.1)
+      warnings.push_back(fmt::format(
+          "bank '{}' was trained for a focal length of {:.0f} px, this camera has {:.0f} px: templates are "
+          "scale-specific, so retrain it with this camera (vkpose train --camera)",
+          b.object, f_bank, f));
   }
-  /// Wall and device milliseconds since the last restart; restarts.
-  std::pair<double, double> split() {
-    const std::pair<double, double> ms{msSince(wall0_), gpu::deviceMilliseconds(ctx_) - device0_};
-    restart();
-    return ms;
-  }
-  /// Ends the stage (less `less` wall and device ms spent in a stage timed inside it, as
-  /// split() gave them) and starts the next.
-  void end(const char* stage, DetectionResult& r, std::pair<double, double> less = {0, 0}) {
-    const auto [wall, device] = split();
-    r.timings_ms.emplace_back(stage, wall - less.first);
-    r.kernel_ms.emplace_back(stage, device - less.second);
-  }
+  return warnings;
+}
 
- private:
-  const GpuContext& ctx_;
-  std::chrono::steady_clock::time_point wall0_;
-  double device0_ = 0;
-};
+/// Without stages 6-8: each hypothesis at its best template's pose (templatePose).
+std::vector<Detection> templateDetections(const std::vector<Hypothesis>& hypotheses,
+                                          const std::vector<TemplateBank>& banks, const Camera& camera) {
+  std::vector<Detection> detections;
+  for (const auto& h : hypotheses) {
+    Detection d = hypothesisDetection(h, banks);
+    const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
+    const BankTemplate& t = bank.templates[static_cast<std::size_t>(d.template_index)];
+    d.pose = templatePose(h, h.member_scores[static_cast<std::size_t>(h.best_member)], t, bank, camera);
+    detections.push_back(std::move(d));
+  }
+  return detections;
+}
 
 Pose templatePose(const Hypothesis& h, const MemberScore& s, const BankTemplate& t, const TemplateBank& bank,
                   const Camera& camera) {
@@ -187,8 +159,9 @@ Camera frameCamera(const LinemodFrame& frame, const Camera& frame_camera, const 
   // scene_camera.json entries carry no image size: the frame's is the one that counts. A
   // principal point outside the frame means the intrinsics are for another camera.
   Camera camera = frame_camera;
-  camera.width = frame.depth_mm.cols;
-  camera.height = frame.depth_mm.rows;
+  const cv::Mat& sized = frame.depth_mm.empty() ? frame.bgr : frame.depth_mm;
+  camera.width = sized.cols;
+  camera.height = sized.rows;
   validateCamera(camera);
   if (camera.cx < 0 || camera.cy < 0 || camera.cx > camera.width || camera.cy > camera.height)
     throw InputError(fmt::format("the principal point ({}, {}) lies outside the {}x{} frame: wrong camera file?",
@@ -215,6 +188,10 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   // A frame in flight that is not this one (an earlier frame threw before collecting it)
   // is finished and dropped.
   if (matcher_->inFlight() && in_flight_ != &frame) (void)matcher_->collect();
+  if (frame.depth_mm.empty()) {  // colour only (src/pipeline/colour_only.cpp)
+    in_flight_ = nullptr;
+    return detectColourOnly(frame, frame_camera);
+  }
   const bool submitted = matcher_->inFlight();
   in_flight_ = nullptr;
   const Camera camera = frameCamera(frame, frame_camera, banks_.front().params.features);

@@ -197,6 +197,23 @@ void validateDetectorParams(const DetectorParams& p) {
   if (!(p.duplicate_fraction >= 0.f && p.duplicate_fraction <= 10.f))
     throw InputError(fmt::format("the duplicate distance must be in [0, 10] diameters, not {}", p.duplicate_fraction));
   validateSensorParams(p.sensor);
+  const ColourOnlyParams& c = p.colour_only;
+  if (c.candidates_per_object < 1)
+    throw InputError(fmt::format("colour-only pose candidates per object must be at least 1, not {}",
+                                 c.candidates_per_object));
+  if (!(c.threshold > 0.f && c.threshold <= 100.f))
+    throw InputError(fmt::format("the colour-only match threshold must be in (0, 100] percent, not {}", c.threshold));
+  if (c.starts < 1 || c.starts > 16)
+    throw InputError(fmt::format("colour-only rotation starts must be 1..16, not {}", c.starts));
+  if (!(c.canny_low > 0.f && c.canny_high >= c.canny_low && c.canny_high <= 5000.f))
+    throw InputError(fmt::format("colour-only Canny thresholds must satisfy 0 < low <= high <= 5000, not {} and {}",
+                                 c.canny_low, c.canny_high));
+  if (!(c.edge_tolerance_px > 0.f && c.edge_tolerance_px <= 20.f))
+    throw InputError(fmt::format("the colour-only edge tolerance must be in (0, 20] pixels, not {}", c.edge_tolerance_px));
+  if (!(c.min_contour_support >= 0.f && c.min_contour_support <= 1.f))
+    throw InputError(fmt::format("the colour-only contour support must be in [0, 1], not {}", c.min_contour_support));
+  if (!(c.min_colour_agreement >= -1.f && c.min_colour_agreement <= 1.f))
+    throw InputError(fmt::format("the colour-only colour agreement must be in [-1, 1], not {}", c.min_colour_agreement));
 }
 
 }  // namespace vkpose

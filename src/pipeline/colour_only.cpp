@@ -1,0 +1,327 @@
+// Frames without depth (colour_only.hpp): the Detector's colour-only flow and its steps.
+#include "pipeline/colour_only.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "pipeline/pipeline.hpp"
+#include "pose/appearance.hpp"
+#include "render/render.hpp"
+#include "util/parallel.hpp"
+#include "util/timing.hpp"
+#include "vkpose/error.hpp"
+
+namespace vkpose {
+
+using util::msSince;
+
+namespace {
+/// Fewer outline points than this at the final pose: too small or too far off the image to say.
+constexpr std::size_t kMinContourPoints = 30;
+}  // namespace
+
+std::vector<LinemodTemplate> colourTemplates(const std::vector<TemplateBank>& banks, std::vector<int>& global_ids) {
+  std::vector<LinemodTemplate> out;
+  global_ids.clear();
+  int id = 0;
+  for (const TemplateBank& bank : banks) {
+    if (!bank.params.features.use_colour)
+      throw InputError(fmt::format(
+          "bank '{}' has no colour modality (trained on depth alone), so it cannot detect in a frame without depth: "
+          "give the depth image, or train the bank with colour (the default)",
+          bank.object));
+    for (const BankTemplate& t : bank.templates) {
+      LinemodTemplate c = t.linemod;
+      bool usable = true;
+      for (TemplateLevel& level : c.levels) {
+        std::erase_if(level.features, [](const TemplateFeature& f) { return f.modality != Modality::ColourGradient; });
+        usable = usable && !level.features.empty();
+      }
+      if (usable) {
+        out.push_back(std::move(c));
+        global_ids.push_back(id);
+      }
+      ++id;
+    }
+  }
+  if (out.empty()) throw InputError("no template of the banks has colour features: nothing to match without depth");
+  return out;
+}
+
+void scoreBySimilarity(std::vector<Hypothesis>& hypotheses) {
+  for (Hypothesis& h : hypotheses) {
+    h.member_scores.assign(h.members.size(), MemberScore{});
+    const std::size_t n = std::min<std::size_t>(3, h.members.size());
+    float sum = 0.f;
+    for (std::size_t k = 0; k < n; ++k) sum += h.members[k].similarity;  // best first
+    h.score = n ? sum / (100.f * static_cast<float>(n)) : 0.f;
+    h.alpha = h.beta = 0.f;
+    h.best_member = h.members.empty() ? -1 : 0;
+  }
+}
+
+namespace {
+
+/// Each candidate's model rendered at `poses[i]` in its own window (one submit each, in the
+/// calling thread: the renderers share one workspace).
+std::vector<std::pair<Rendering, cv::Rect>> renderAt(const std::vector<PoseCandidate>& candidates,
+                                                     const std::vector<Pose>& poses,
+                                                     const std::vector<PoseObject>& objects, const Camera& camera) {
+  std::vector<std::pair<Rendering, cv::Rect>> out(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const PoseObject& o = objects[candidates[i].bank()];
+    const cv::Rect window = projectedWindow(poses[i], o.bank->centre, o.bounding_radius, camera);
+    if (window.width < 4 || window.height < 4) continue;
+    out[i] = {std::move(o.renderer->render(windowCamera(camera, window), {poses[i]}).front()), window};
+  }
+  return out;
+}
+
+/// Why a fitted pose cannot be the hypothesis's object (empty: it can): too little outline to
+/// have fitted, a distance outside the bank's trained radii (the fit slid along the ray,
+/// where the outline says least), or a centre that left the hypothesis's place.
+std::string implausibleFit(const PoseCandidate& c, const Pose& pose, const TemplateBank& bank, const Camera& camera,
+                           std::size_t points) {
+  if (points < kMinContourPoints)
+    return fmt::format("{} points of outline, too few to fit ({} needed)", points, kMinContourPoints);
+  const Eigen::Vector3f centre = pose.R * bank.centre + pose.t;
+  const float near = 0.75f * bank.params.views.radii.from, far = 1.33f * bank.params.views.radii.to;
+  if (!(centre.z() >= near && centre.z() <= far))
+    return fmt::format("the fit moved it to {:.2f} m, outside the trained distances ({:.2f}-{:.2f} m)", centre.z(),
+                       bank.params.views.radii.from, bank.params.views.radii.to);
+  const Eigen::Vector2f at = camera.project(centre);
+  const float diameter_px = bank.diameter * static_cast<float>(camera.fx) / centre.z();
+  if ((at - Eigen::Vector2f(c.detection.x, c.detection.y)).norm() > 0.5f * diameter_px)
+    return "the fit slid off its hypothesis's place";
+  return {};
+}
+
+/// The colour agreement of a rendering with the frame over its mask (appearanceAgreement with
+/// the rendering's own depth standing in for the scene's: every rendered pixel counts).
+AppearanceAgreement colourAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& bgr) {
+  const cv::Mat seen = bgr(window).clone();
+  return appearanceAgreement(rendering, cv::Rect(0, 0, window.width, window.height), seen, rendering.depth, 1.f, true);
+}
+
+}  // namespace
+
+void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                           const PoseFrame& frame, const EdgeDistanceMaps& maps, const DetectorParams& params) {
+  const ColourOnlyParams& cp = params.colour_only;
+  const ContourFitParams fit_params;
+  const std::size_t n = candidates.size();
+  std::vector<Pose> poses(n);
+  for (std::size_t i = 0; i < n; ++i) poses[i] = candidates[i].start;
+  std::vector<char> lost(n, 0);
+  for (const float truncation : fit_params.truncation_px) {
+    auto rendered = renderAt(candidates, poses, objects, frame.camera);
+    util::parallelFor(
+        n,
+        [&](std::size_t i) {
+          if (lost[i]) return;
+          const auto start = std::chrono::steady_clock::now();
+          const auto& [rendering, window] = rendered[i];
+          if (window.empty()) {
+            lost[i] = 1;
+            return;
+          }
+          const auto points = contourPoints(rendering, poses[i], frame.camera, window);
+          const ContourFit fit =
+              fitContourRound(points, poses[i], frame.camera, maps, truncation, fit_params.iterations);
+          poses[i] = fit.pose;
+          candidates[i].detection.icp_iterations += fit.iterations;
+          candidates[i].cpu_ms += msSince(start);
+        },
+        params.threads);
+  }
+  // Verification at the final pose.
+  auto rendered = renderAt(candidates, poses, objects, frame.camera);
+  util::parallelFor(
+      n,
+      [&](std::size_t i) {
+        PoseCandidate& c = candidates[i];
+        Detection& d = c.detection;
+        d.pose = poses[i];
+        d.colour_only = true;
+        const auto& [rendering, window] = rendered[i];
+        if (lost[i] || window.empty()) {
+          d.rejection = "the model renders outside the image";
+          d.score = 0.f;
+          return;
+        }
+        const auto points = contourPoints(rendering, poses[i], frame.camera, window);
+        if (const std::string why = implausibleFit(c, poses[i], *objects[c.bank()].bank, frame.camera, points.size());
+            !why.empty()) {
+          d.rejection = why;
+          d.score = 0.f;
+          return;
+        }
+        d.contour_edges = chamferSupport(points, poses[i], frame.camera, maps, cp.edge_tolerance_px);
+        const AppearanceAgreement colour = colourAgreement(rendering, window, frame.bgr);
+        const bool colour_counts = !objects[c.bank()].bank->mesh.colours.empty() && colour.colour_informative;
+        d.colour_agreement = colour_counts ? colour.colour : 1.f;
+        d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
+        d.score = d.contour_edges * d.explained_edges * (colour_counts ? 0.5f * (1.f + colour.colour) : 1.f);
+        if (d.contour_edges < cp.min_contour_support)
+          d.rejection = fmt::format("{:.0f} % of its outline meets an image edge, {:.0f} % needed",
+                                    100.f * d.contour_edges, 100.f * cp.min_contour_support);
+        else if (colour_counts && cp.min_colour_agreement > -1.f && colour.colour < cp.min_colour_agreement)
+          d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour,
+                                    cp.min_colour_agreement);
+        d.verified = d.rejection.empty();
+      },
+      params.threads);
+}
+
+/// Of each hypothesis's starts the best scored; the others go to the rejected.
+static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& hypothesis_of,
+                          DetectionResult& result) {
+  std::vector<int> best(candidates.size(), -1);
+  std::size_t hypotheses = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const std::size_t h = hypothesis_of[i];
+    hypotheses = std::max(hypotheses, h + 1);
+    int& b = best[h];
+    if (b < 0 || candidates[i].detection.score > candidates[static_cast<std::size_t>(b)].detection.score)
+      b = static_cast<int>(i);
+  }
+  std::vector<PoseCandidate> kept;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (best[hypothesis_of[i]] == static_cast<int>(i)) {
+      kept.push_back(std::move(candidates[i]));
+    } else if (candidates[i].detection.verified) {
+      candidates[i].detection.verified = false;
+      candidates[i].detection.rejection = "another rotation start of its hypothesis fit better";
+      result.rejected.push_back(std::move(candidates[i].detection));
+    }
+  }
+  candidates = std::move(kept);
+}
+
+/// The accepted candidates, best score first, each unless a better one's centre projects
+/// within half the smaller projected diameter of its own (one place holds one object: without
+/// depth, two objects cannot be told apart along a ray).
+static void acceptByContour(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
+                            const Camera& camera, DetectionResult& result) {
+  std::stable_sort(candidates.begin(), candidates.end(), [](const PoseCandidate& a, const PoseCandidate& b) {
+    return a.detection.score > b.detection.score;
+  });
+  struct Place {
+    Eigen::Vector2f at;
+    float radius;
+  };
+  std::vector<Place> taken;
+  for (PoseCandidate& c : candidates) {
+    Detection& d = c.detection;
+    if (!d.verified) {
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    const TemplateBank& bank = banks[c.bank()];
+    const Eigen::Vector3f centre = d.pose.R * bank.centre + d.pose.t;
+    const Place place{camera.project(centre), 0.5f * bank.diameter * static_cast<float>(camera.fx) / centre.z()};
+    const bool duplicate = std::any_of(taken.begin(), taken.end(), [&](const Place& p) {
+      return (p.at - place.at).norm() < std::min(p.radius, place.radius);
+    });
+    if (duplicate) {
+      d.verified = false;
+      d.rejection = "a better detection holds its place";
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    taken.push_back(place);
+    d.x = place.at.x();
+    d.y = place.at.y();
+    result.detections.push_back(std::move(d));
+  }
+}
+
+DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Camera& frame_camera) {
+  FeatureParams features = banks_.front().params.features;
+  features.use_depth = false;
+  const Camera camera = frameCamera(frame, frame_camera, features);
+  if (!colour_only_) {
+    auto stages = std::make_unique<ColourOnlyStages>();
+    std::vector<LinemodTemplate> templates = colourTemplates(banks_, stages->global_ids);
+    MatchParams match = params_.match;
+    match.threshold = params_.colour_only.threshold;
+    stages->matcher = std::make_unique<LinemodMatcher>(ctx_, features, match);
+    stages->matcher->setTemplates(std::move(templates));
+    colour_only_ = std::move(stages);
+  }
+  DetectionResult result;
+  result.warnings = focalLengthWarnings(banks_, camera);
+  const auto total0 = std::chrono::steady_clock::now();
+  std::vector<Match> matches = colour_only_->matcher->match(frame);
+  for (Match& m : matches) m.template_id = colour_only_->global_ids[static_cast<std::size_t>(m.template_id)];
+  appendMatchTimings(colour_only_->matcher->lastTimings(), result);
+  result.matches = matches.size();
+
+  StageClock clock(ctx_);
+  std::vector<Hypothesis> hypotheses = clusterTemplates(matches, banks_, params_.cluster);
+  result.hypotheses = hypotheses.size();
+  clock.end("clustering", result);
+  scoreBySimilarity(hypotheses);
+  result.scored_hypotheses = hypotheses.size();
+  clock.end("scoring", result);
+
+  NmsParams nms = params_.nms;
+  nms.across_objects = !params_.estimate_poses;
+  nms.small_part_radius_fraction = nms.radius_fraction;
+  hypotheses = suppressNonMaxima(std::move(hypotheses), banks_, camera.fx, nms);
+  std::vector<int> taken(banks_.size(), 0);
+  std::erase_if(hypotheses, [&](const Hypothesis& h) {
+    return taken[static_cast<std::size_t>(h.bank)]++ >= params_.colour_only.candidates_per_object;
+  });
+  clock.end("nms", result);
+  if (!params_.estimate_poses) {
+    result.detections = templateDetections(hypotheses, banks_, camera);
+    result.timings_ms.emplace_back("total", msSince(total0));
+    return result;
+  }
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double cpu0 = util::processCpuMs();
+  const cv::Mat no_depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0));
+  const PoseFrame pose_frame = poseFrame(camera, no_depth, frame.bgr);
+  // Several rotation starts a hypothesis (the largest groups of its templates' rotations):
+  // without depth a cluster mixes views whose outlines look alike more often, and the fit
+  // cannot turn far. The best-supported start of each hypothesis is kept.
+  std::vector<PoseCandidate> candidates;
+  std::vector<std::size_t> hypothesis_of;
+  for (std::size_t k = 0; k < hypotheses.size(); ++k) {
+    const Hypothesis& h = hypotheses[k];
+    const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
+    const InitialRotation rot =
+        initialRotation(h, bank, camera, params_.initial_pose, params_.score, params_.colour_only.starts);
+    std::vector<RotationStart> starts{{rot.R, rot.group_size}};
+    starts.insert(starts.end(), rot.more.begin(), rot.more.end());
+    for (const RotationStart& s : starts) {
+      PoseCandidate& c = candidates.emplace_back();
+      c.detection = hypothesisDetection(h, banks_);
+      c.detection.rotation_votes = s.votes;
+      c.start = poseOnViewingRay(s.R, h, bank, camera, params_.initial_pose.range_along_ray);
+      hypothesis_of.push_back(k);
+    }
+  }
+  attachRenderers();
+  clock.end("initial_pose", result);
+  const EdgeDistanceMaps maps = edgeDistanceMaps(frame.bgr, params_.colour_only.canny_low, params_.colour_only.canny_high);
+  clock.end("edges", result);
+  fitAndVerifyByContour(candidates, objects_, pose_frame, maps, params_);
+  for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
+  clock.end("contour_fit", result);
+  keepBestStart(candidates, hypothesis_of, result);
+  acceptByContour(candidates, banks_, camera, result);
+  clock.end("verification", result);
+  result.pose_wall_ms = msSince(wall0);
+  result.pose_cpu_ms = util::processCpuMs() - cpu0;
+  result.pose_threads = util::threadsFor(candidates.size(), params_.threads);
+  result.timings_ms.emplace_back("total", msSince(total0));
+  return result;
+}
+
+}  // namespace vkpose

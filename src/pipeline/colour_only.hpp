@@ -1,0 +1,37 @@
+#pragma once
+// Frames without depth (docs/pipeline.md, colour only): what the Detector keeps for them, and
+// the steps that differ from the RGB-D path, as plain functions.
+#include <memory>
+#include <vector>
+
+#include "hypotheses/hypotheses.hpp"
+#include "match/matcher.hpp"
+#include "pose/candidate.hpp"
+#include "pose/contour_fit.hpp"
+#include "vkpose/detector.hpp"
+
+namespace vkpose {
+
+struct Detector::ColourOnlyStages {
+  std::unique_ptr<LinemodMatcher> matcher;
+  /// The colour matcher's template ids to the global ones (TemplateIndex): templates with no
+  /// colour feature at some level are left out of it.
+  std::vector<int> global_ids;
+};
+
+/// The banks' templates with their depth features dropped, and for each the global template
+/// id it came from. Throws InputError when a bank has no colour modality.
+std::vector<LinemodTemplate> colourTemplates(const std::vector<TemplateBank>& banks, std::vector<int>& global_ids);
+
+/// Stage 4 without depth: each hypothesis scored by the mean similarity (0..1) of its best
+/// three members, its best member the best match; member scores left empty of depth.
+void scoreBySimilarity(std::vector<Hypothesis>& hypotheses);
+
+/// Stages 7-8 without depth for each candidate: rounds of rendering, outline extraction and
+/// the directional chamfer fit (contour_fit.hpp), then the outline's support and the colour
+/// agreement at the final pose. Fills detection (pose, score, contour_edges, colour_agreement,
+/// verified, rejection).
+void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                           const PoseFrame& frame, const EdgeDistanceMaps& maps, const DetectorParams& params);
+
+}  // namespace vkpose

@@ -1,0 +1,115 @@
+// Colour-only detection (docs/pipeline.md, frames without depth): the directional chamfer fit of
+// stage 7 on a rendered scene, the 2D projection metric, and the detector on the real LM-O frame
+// with its depth withheld.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "mesh_support.hpp"
+#include "pipeline/colour_only.hpp"
+#include "pose/contour_fit.hpp"
+#include "pose/initial_pose.hpp"
+#include "render/render.hpp"
+#include "test_support.hpp"
+#include "vkpose/evaluation.hpp"
+
+namespace vkpose {
+namespace {
+
+TEST(ContourFit, OrientationBinsIgnoreTheSign) {
+  EXPECT_EQ(edgeOrientationBin(1, 0), 0);
+  EXPECT_EQ(edgeOrientationBin(-1, 0), 0);
+  EXPECT_EQ(edgeOrientationBin(1, 1), 2);
+  EXPECT_EQ(edgeOrientationBin(0, 1), 4);
+  EXPECT_EQ(edgeOrientationBin(0, -1), 4);
+  EXPECT_EQ(edgeOrientationBin(-1, 1), 6);
+  EXPECT_EQ(edgeOrientationBin(1, -1), 6);
+}
+
+struct Scene {
+  Mesh mesh = test::lShapeMesh();
+  Camera camera;
+  Pose truth;
+  cv::Mat bgr;
+};
+
+/// The L-shape rendered (the reference rasterizer, shaded grey) on an orange background (a
+/// grey one would hide the outline wherever a face is shaded the same grey).
+Scene renderedScene() {
+  Scene s;
+  s.truth.R = (Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitX()) * Eigen::AngleAxisf(0.3f, Eigen::Vector3f::UnitY()))
+                  .toRotationMatrix();
+  s.truth.t = {0.03f, -0.02f, 0.6f};
+  const Rendering r = renderReference(s.mesh, s.camera, s.truth);
+  s.bgr = cv::Mat(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(20, 90, 200));
+  r.bgr.copyTo(s.bgr, r.mask());
+  return s;
+}
+
+/// proj2d of the mesh's vertices between two poses, pixels.
+float proj2d(const Scene& s, const Pose& p) {
+  return proj2dError(s.mesh.vertices, p.R, p.t, s.truth.R, s.truth.t, s.camera);
+}
+
+/// Rounds of render, outline and fit from `start`, as the detector runs them.
+Pose fitFrom(const Scene& s, const EdgeDistanceMaps& maps, Pose pose) {
+  float radius = 0.f;
+  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
+  for (const float truncation : ContourFitParams{}.truncation_px) {
+    const cv::Rect window = projectedWindow(pose, Eigen::Vector3f::Zero(), radius, s.camera);
+    const Rendering r = renderReference(s.mesh, windowCamera(s.camera, window), pose);
+    const auto points = contourPoints(r, pose, s.camera, window);
+    EXPECT_GT(points.size(), 50u);
+    pose = fitContourRound(points, pose, s.camera, maps, truncation, ContourFitParams{}.iterations).pose;
+  }
+  return pose;
+}
+
+TEST(ContourFit, PullsAShiftedAndTurnedPoseBackOntoTheEdges) {
+  const Scene s = renderedScene();
+  const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
+  Pose start = s.truth;
+  start.R = Eigen::AngleAxisf(0.08f, Eigen::Vector3f(0.3f, 1.f, 0.2f).normalized()).toRotationMatrix() * s.truth.R;
+  start.t += Eigen::Vector3f(0.006f, 0.004f, 0.02f);  // about 6 and 4 px, and 2 cm farther
+  ASSERT_GT(proj2d(s, start), 6.f);
+  const Pose fitted = fitFrom(s, maps, start);
+  EXPECT_LT(proj2d(s, fitted), 1.5f) << "from " << proj2d(s, start) << " px";
+}
+
+TEST(ContourFit, SupportIsHighOnTheObjectAndLowBesideIt) {
+  const Scene s = renderedScene();
+  const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
+  float radius = 0.f;
+  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
+  const cv::Rect window = projectedWindow(s.truth, Eigen::Vector3f::Zero(), radius, s.camera);
+  const auto points =
+      contourPoints(renderReference(s.mesh, windowCamera(s.camera, window), s.truth), s.truth, s.camera, window);
+  EXPECT_GT(chamferSupport(points, s.truth, s.camera, maps), 0.9f);
+  Pose beside = s.truth;
+  beside.t.x() += 0.012f;  // about 11 px
+  EXPECT_LT(chamferSupport(points, beside, s.camera, maps), 0.4f);
+}
+
+TEST(Proj2d, IsZeroForThePoseItselfAndTheShiftInPixels) {
+  const Camera camera;
+  const std::vector<Eigen::Vector3f> points{{0.f, 0.f, 0.f}, {0.05f, 0.f, 0.f}, {0.f, 0.05f, 0.02f}};
+  const Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  const Eigen::Vector3f t(0.f, 0.f, 1.f);
+  EXPECT_FLOAT_EQ(proj2dError(points, R, t, R, t, camera), 0.f);
+  // 1 cm sideways at 1 m: fx * 0.01 px for the points at z = 1, a little less for the far one.
+  const float e = proj2dError(points, R, t + Eigen::Vector3f(0.01f, 0.f, 0.f), R, t, camera);
+  EXPECT_NEAR(e, static_cast<float>(camera.fx) * 0.01f, 0.1f);
+  EXPECT_LT(e, static_cast<float>(camera.fx) * 0.01f);
+}
+
+TEST(ColourOnly, ABankWithoutTheColourModalityIsAClearError) {
+  TemplateBank bank;
+  bank.object = "depth_only";
+  bank.params.features.use_colour = false;
+  std::vector<int> ids;
+  test::expectInputError([&] { (void)colourTemplates({bank}, ids); }, {"depth_only", "colour"});
+}
+
+}  // namespace
+}  // namespace vkpose
