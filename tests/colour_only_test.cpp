@@ -2,6 +2,7 @@
 // stage 7 on a rendered scene, the 2D projection metric, and the detector on the real LM-O frame
 // with its depth withheld.
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -101,6 +102,28 @@ TEST(Proj2d, IsZeroForThePoseItselfAndTheShiftInPixels) {
   const float e = proj2dError(points, R, t + Eigen::Vector3f(0.01f, 0.f, 0.f), R, t, camera);
   EXPECT_NEAR(e, static_cast<float>(camera.fx) * 0.01f, 0.1f);
   EXPECT_LT(e, static_cast<float>(camera.fx) * 0.01f);
+}
+
+TEST(Proj2d, ASymmetricObjectTurnedAboutItsAxisIsNotWrong) {
+  // A ring of points about z: turned 30 degrees about z it projects onto itself, which ADD's
+  // rule counts as tens of pixels off and ADI's as none.
+  std::vector<Eigen::Vector3f> ring;
+  for (int k = 0; k < 360; ++k)
+    ring.emplace_back(0.05f * std::cos(k * 0.0174533f), 0.05f * std::sin(k * 0.0174533f), 0.f);
+  std::map<int, EvalModel> models;
+  ModelInfo info;
+  info.diameter = 0.1f;
+  info.symmetric = true;
+  models.emplace(1, makeEvalModel(info, ring));
+  const Camera camera;
+  GroundTruthPose gt;
+  gt.obj_id = 1;
+  gt.t = {0.f, 0.f, 0.8f};
+  PoseEstimate turned{1, 1.f, Eigen::AngleAxisf(0.5236f, Eigen::Vector3f::UnitZ()).toRotationMatrix(), gt.t};
+  EXPECT_LT(poseError(models.at(1), turned, gt, PoseErrorType::Proj2D, &camera), 0.2f);
+  models.at(1).info.symmetric = false;
+  EXPECT_GT(poseError(models.at(1), turned, gt, PoseErrorType::Proj2D, &camera), 10.f);
+  EXPECT_ANY_THROW((void)poseError(models.at(1), turned, gt, PoseErrorType::Proj2D, nullptr));
 }
 
 TEST(ColourOnly, ABankWithoutTheColourModalityIsAClearError) {

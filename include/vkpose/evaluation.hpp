@@ -152,8 +152,9 @@ enum class PoseErrorType {
   ADD,   ///< ADD for every object
   ADI,   ///< ADI for every object
   /// Mean 2D projection distance of the model points under the two poses, pixels, with the
-  /// image's camera: the usual score of colour-only methods (correct under
-  /// EvalParams::proj2d_px, 5 px, whatever the diameter). Blind to depth along the ray.
+  /// image's camera (for symmetric objects, ADI's rule: to the nearest projected point): the
+  /// usual score of colour-only methods (correct under EvalParams::proj2d_px, 5 px, whatever
+  /// the diameter). Blind to depth along the ray.
   Proj2D,
 };
 
