@@ -109,7 +109,8 @@ AppearanceAgreement colourAgreement(const Rendering& rendering, const cv::Rect& 
 }  // namespace
 
 void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
-                           const PoseFrame& frame, const EdgeDistanceMaps& maps, const DetectorParams& params) {
+                           const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                           const DetectorParams& params) {
   const ColourOnlyParams& cp = params.colour_only;
   const ContourFitParams fit_params;
   const std::size_t n = candidates.size();
@@ -117,7 +118,7 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
   for (std::size_t i = 0; i < n; ++i) poses[i] = candidates[i].start;
   std::vector<char> lost(n, 0);
   for (const float truncation : fit_params.truncation_px) {
-    auto rendered = renderAt(candidates, poses, objects, frame.camera);
+    auto rendered = renderAt(candidates, poses, objects, camera);
     util::parallelFor(
         n,
         [&](std::size_t i) {
@@ -128,9 +129,9 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
             lost[i] = 1;
             return;
           }
-          const auto points = contourPoints(rendering, poses[i], frame.camera, window);
+          const auto points = contourPoints(rendering, poses[i], camera, window);
           const ContourFit fit =
-              fitContourRound(points, poses[i], frame.camera, maps, truncation, fit_params.iterations);
+              fitContourRound(points, poses[i], camera, maps, truncation, fit_params.iterations);
           poses[i] = fit.pose;
           candidates[i].detection.icp_iterations += fit.iterations;
           candidates[i].cpu_ms += msSince(start);
@@ -138,7 +139,7 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         params.threads);
   }
   // Verification at the final pose.
-  auto rendered = renderAt(candidates, poses, objects, frame.camera);
+  auto rendered = renderAt(candidates, poses, objects, camera);
   util::parallelFor(
       n,
       [&](std::size_t i) {
@@ -152,15 +153,15 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
           d.score = 0.f;
           return;
         }
-        const auto points = contourPoints(rendering, poses[i], frame.camera, window);
-        if (const std::string why = implausibleFit(c, poses[i], *objects[c.bank()].bank, frame.camera, points.size());
+        const auto points = contourPoints(rendering, poses[i], camera, window);
+        if (const std::string why = implausibleFit(c, poses[i], *objects[c.bank()].bank, camera, points.size());
             !why.empty()) {
           d.rejection = why;
           d.score = 0.f;
           return;
         }
-        d.contour_edges = chamferSupport(points, poses[i], frame.camera, maps, cp.edge_tolerance_px);
-        const AppearanceAgreement colour = colourAgreement(rendering, window, frame.bgr);
+        d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
+        const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
         const bool colour_counts = !objects[c.bank()].bank->mesh.colours.empty() && colour.colour_informative;
         d.colour_agreement = colour_counts ? colour.colour : 1.f;
         d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
@@ -176,15 +177,13 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
       params.threads);
 }
 
-/// Of each hypothesis's starts the best scored; the others go to the rejected.
+/// Of each hypothesis's starts the best scored; the others that had passed go to the rejected
+/// (those that had not are dropped: their hypothesis is represented by the best).
 static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& hypothesis_of,
                           DetectionResult& result) {
   std::vector<int> best(candidates.size(), -1);
-  std::size_t hypotheses = 0;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    const std::size_t h = hypothesis_of[i];
-    hypotheses = std::max(hypotheses, h + 1);
-    int& b = best[h];
+    int& b = best[hypothesis_of[i]];
     if (b < 0 || candidates[i].detection.score > candidates[static_cast<std::size_t>(b)].detection.score)
       b = static_cast<int>(i);
   }
@@ -285,33 +284,22 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
 
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = util::processCpuMs();
-  const cv::Mat no_depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0));
-  const PoseFrame pose_frame = poseFrame(camera, no_depth, frame.bgr);
   // Several rotation starts a hypothesis (the largest groups of its templates' rotations):
   // without depth a cluster mixes views whose outlines look alike more often, and the fit
-  // cannot turn far. The best-supported start of each hypothesis is kept.
+  // cannot turn far. The best-supported start of each hypothesis is kept. (No start by fit:
+  // scoreBySimilarity leaves the members without a depth fit.)
   std::vector<PoseCandidate> candidates;
   std::vector<std::size_t> hypothesis_of;
-  for (std::size_t k = 0; k < hypotheses.size(); ++k) {
-    const Hypothesis& h = hypotheses[k];
-    const TemplateBank& bank = banks_[static_cast<std::size_t>(h.bank)];
-    const InitialRotation rot =
-        initialRotation(h, bank, camera, params_.initial_pose, params_.score, params_.colour_only.starts);
-    std::vector<RotationStart> starts{{rot.R, rot.group_size}};
-    starts.insert(starts.end(), rot.more.begin(), rot.more.end());
-    for (const RotationStart& s : starts) {
-      PoseCandidate& c = candidates.emplace_back();
-      c.detection = hypothesisDetection(h, banks_);
-      c.detection.rotation_votes = s.votes;
-      c.start = poseOnViewingRay(s.R, h, bank, camera, params_.initial_pose.range_along_ray);
+  for (std::size_t k = 0; k < hypotheses.size(); ++k)
+    for (PoseCandidate& c : hypothesisStarts(hypotheses[k], banks_, camera, params_, params_.colour_only.starts)) {
+      candidates.push_back(std::move(c));
       hypothesis_of.push_back(k);
     }
-  }
   attachRenderers();
   clock.end("initial_pose", result);
   const EdgeDistanceMaps maps = edgeDistanceMaps(frame.bgr, params_.colour_only.canny_low, params_.colour_only.canny_high);
   clock.end("edges", result);
-  fitAndVerifyByContour(candidates, objects_, pose_frame, maps, params_);
+  fitAndVerifyByContour(candidates, objects_, camera, frame.bgr, maps, params_);
   for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
   clock.end("contour_fit", result);
   keepBestStart(candidates, hypothesis_of, result);

@@ -71,18 +71,27 @@ std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypoth
     const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
     const int starts = std::max(isSmallPart(bank.diameter) ? ip.small_part_starts : 1,
                                 bank.params.views.other_ups.empty() ? 1 : ip.resting_poses_starts);
-    const InitialRotation rot = initialRotation(h, bank, camera, ip, params.score, starts);
-    const auto start = [&](const Eigen::Matrix3f& R, int votes) {
-      PoseCandidate& c = candidates.emplace_back();
-      c.detection = hypothesisDetection(h, banks);
-      c.detection.rotation_votes = votes;
-      c.start = poseOnViewingRay(R, h, bank, camera, ip.range_along_ray);
-    };
-    start(rot.R, rot.group_size);
-    for (const RotationStart& s : rot.more) start(s.R, s.votes);
-    if (rot.by_fit) start(rot.by_fit->R, rot.by_fit->votes);
+    for (PoseCandidate& c : hypothesisStarts(h, banks, camera, params, starts)) candidates.push_back(std::move(c));
   }
   return candidates;
+}
+
+std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vector<TemplateBank>& banks,
+                                            const Camera& camera, const DetectorParams& params, int starts) {
+  const InitialPoseParams& ip = params.initial_pose;
+  const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
+  const InitialRotation rot = initialRotation(h, bank, camera, ip, params.score, starts);
+  std::vector<PoseCandidate> out;
+  const auto start = [&](const Eigen::Matrix3f& R, int votes) {
+    PoseCandidate& c = out.emplace_back();
+    c.detection = hypothesisDetection(h, banks);
+    c.detection.rotation_votes = votes;
+    c.start = poseOnViewingRay(R, h, bank, camera, ip.range_along_ray);
+  };
+  start(rot.R, rot.group_size);
+  for (const RotationStart& s : rot.more) start(s.R, s.votes);
+  if (rot.by_fit) start(rot.by_fit->R, rot.by_fit->votes);
+  return out;
 }
 
 void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,

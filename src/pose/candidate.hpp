@@ -90,6 +90,12 @@ std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypoth
                                            const std::vector<TemplateBank>& banks, const Camera& camera,
                                            const DetectorParams& params);
 
+/// One hypothesis's starts: its largest rotation group, the next largest up to `starts` in all,
+/// and the group that fits best by stage 4 where that is another (initialRotation), each posed
+/// on its viewing ray.
+std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vector<TemplateBank>& banks,
+                                            const Camera& camera, const DetectorParams& params, int starts);
+
 /// Stage 6, translations: each start rendered in its own window (projectedWindow: one small
 /// submit each) and moved by the centroid difference (initialTranslation); then each
 /// candidate's stage 7-8 parameters, scaled for its object at its distance, with the higher
