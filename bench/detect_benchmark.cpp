@@ -136,6 +136,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups
       {"scoring", {"scoring"}},
       {"nms", {"nms"}},
       {"initial_pose", {"initial_pose"}},
+      {"first_fit", {"first_fit"}},
       {"mls", {"mls"}},
       {"icp", {"icp"}},
       {"verification", {"verification"}},
@@ -438,7 +439,7 @@ std::vector<DetectSweepRow> runDetectSweep(const DetectBenchOptions& options, De
     row.templates = r.templates;
     for (const auto& st : r.stages) {
       if (st.stage == "total") row.total_ms = st.median_ms;
-      else if (st.stage == "initial_pose" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification" ||
+      else if (st.stage == "initial_pose" || st.stage == "first_fit" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification" ||
                st.stage == "symmetries")
         row.pose_ms += st.median_ms;
       else row.match_ms += st.median_ms;

@@ -116,7 +116,7 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   EXPECT_GT(r.templates, 0u);
   EXPECT_NE(r.frames_from.find("synthetic"), std::string::npos);
   const std::vector<std::string> stages = {"features",     "similarity", "clustering", "scoring",
-                                           "nms",          "initial_pose", "mls",      "icp",
+                                           "nms",          "initial_pose", "first_fit", "mls",      "icp",
                                            "verification", "symmetries", "total"};
   ASSERT_EQ(r.stages.size(), stages.size());
   double sum = 0;

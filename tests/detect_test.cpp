@@ -1,4 +1,5 @@
 // `vkpose detect` end to end on the real IC-BIN cup frame, and the detection JSON's fields.
+#include <algorithm>
 #include <filesystem>
 
 #include <unistd.h>
@@ -37,13 +38,14 @@ struct IcbinResult {
   std::string json;
 };
 
-IcbinResult detectIcbinScene2(bool poses, unsigned threads = 0) {
+IcbinResult detectIcbinScene2(bool poses, unsigned threads = 0, bool first_fit = true) {
   const std::string d = test::sharedData() + "/icbin/";
   const Camera camera = loadCamera(d + "camera.json");
   const LinemodFrame frame = loadFrame(d + "scene2/rgb/0000.png", d + "scene2/depth/0000.png", camera.depth_scale);
   DetectorParams params;
   params.estimate_poses = poses;
   params.threads = threads;
+  params.refine.first_fit = first_fit;
   Detector detector(test::context(), {icbinCupBank()}, params);
   IcbinResult out;
   out.result = detector.detect(frame, camera);
@@ -188,6 +190,28 @@ TEST(DetectIcbin, PoseStagesOnOneThreadFindTheSameAsOnMany) {
   EXPECT_EQ(withoutTimings(one.json), withoutTimings(four.json));
   EXPECT_GT(one.result.pose_wall_ms, 0.0);
   EXPECT_GT(one.result.pose_cpu_ms, 0.0);
+}
+
+TEST(DetectIcbin, TheFirstFitRefinesFewerStartsAndFindsTheSameCups) {
+  // The first fit stops the starts that cannot pass stage 8 before MLS and ICP (about half
+  // of the starts go on here); the cups found must be the same ones, in the same places.
+  VKPOSE_REQUIRE_SHARED_DATA();
+  const IcbinResult& screened = icbinScene2Poses();
+  const IcbinResult all = detectIcbinScene2(true, 0, false);
+  const auto& found = screened.result.detections;
+  ASSERT_GE(found.size(), 5u);
+  ASSERT_EQ(found.size(), all.result.detections.size());
+  for (const Detection& d : all.result.detections) {
+    const bool kept = std::any_of(found.begin(), found.end(),
+                                  [&](const Detection& s) { return (s.pose.t - d.pose.t).norm() < 0.005f; });
+    EXPECT_TRUE(kept) << "the cup at " << d.pose.t.transpose() << " was lost";
+  }
+  EXPECT_LT(screened.result.refined_candidates * 3, all.result.refined_candidates * 2);
+  EXPECT_LE(static_cast<double>(screened.result.refined_candidates), 2.5 * static_cast<double>(found.size()));
+  // The stopped starts are reported, with the first fit's measurements and why.
+  const auto stopped = std::count_if(screened.result.rejected.begin(), screened.result.rejected.end(),
+                                     [](const Detection& r) { return r.rejection.find("first fit") != std::string::npos; });
+  EXPECT_EQ(static_cast<std::size_t>(stopped) + screened.result.refined_candidates, all.result.refined_candidates);
 }
 
 TEST(DetectIcbin, FramesInFlightFindWhatFrameByFrameFinds) {

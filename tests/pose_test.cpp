@@ -1,6 +1,6 @@
 // Stage 6 (initial pose): rotation distance and mean, clustering of template rotations against
 // the group mean, the viewing-ray correction, and the centroid translation against renderings
-// with a known offset, an occluder and a black hole.
+// with a known offset, an occluder and a black hole. Stage 7's first fit: which starts go on.
 #include <cmath>
 #include <numbers>
 
@@ -11,6 +11,7 @@
 #include "hypotheses/hypotheses.hpp"
 #include "match/features.hpp"
 #include "match/matcher.hpp"
+#include "pose/candidate.hpp"
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
 #include "tests/test_support.hpp"
@@ -296,6 +297,69 @@ TEST(InitialTranslation, ABlackHoleIsRejectedWithAReason) {
   bad = {};
   bad.resting_poses_starts = 0;
   EXPECT_THROW(validateInitialPoseParams(bad), InputError);
+}
+
+/// A start whose first fit put the object's centre at `t` with these measurements.
+PoseCandidate firstFitStart(int bank, const Eigen::Vector3f& t, float collision, float see_through, float silhouette) {
+  PoseCandidate c;
+  c.detection.bank = bank;
+  c.initial.ok = true;
+  c.first_fit.pose.t = t;
+  c.first_evidence.collision.collision_rate = collision;
+  c.first_evidence.depth.seen_through = see_through;
+  c.first_evidence.silhouette_support = silhouette;
+  return c;  // RefineParams and VerifyParams at their defaults: share 0.75, two a place
+}
+
+std::vector<TemplateBank> twoTenCentimetreObjects() {
+  std::vector<TemplateBank> banks(2);
+  banks[0].object = "cup";
+  banks[1].object = "carton";
+  for (auto& b : banks) b.diameter = 0.1f;  // centre at the origin
+  return banks;
+}
+
+TEST(FirstFit, StopsStartsShortOfStageEightsLimitsAndSaysWhy) {
+  const auto banks = twoTenCentimetreObjects();
+  std::vector<PoseCandidate> c;
+  c.push_back(firstFitStart(0, {0.0f, 0, 0.7f}, 0.28f, 0.0f, 1.0f));   // collision under 0.75 x 0.4
+  c.push_back(firstFitStart(0, {0.2f, 0, 0.7f}, 0.35f, 0.0f, 0.40f));  // silhouette under 0.75 x 0.55
+  c.push_back(firstFitStart(0, {0.4f, 0, 0.7f}, 0.35f, 0.25f, 0.9f));  // sees through more than 0.15 / 0.75
+  c.push_back(firstFitStart(0, {0.6f, 0, 0.7f}, 0.35f, 0.1f, 0.5f));   // near enough on every test
+  // At the limit's collision rate the other two tests wait for MLS and ICP (a carton the
+  // table pulled aside in the first fit).
+  c.push_back(firstFitStart(0, {0.8f, 0, 0.7f}, 0.45f, 0.25f, 0.2f));
+  PoseCandidate unplaced = firstFitStart(0, {1.0f, 0, 0.7f}, 0.f, 1.f, 0.f);
+  unplaced.initial.ok = false;
+  c.push_back(unplaced);
+  screenStarts(c, banks, 0.3f);
+  EXPECT_NE(c[0].screened.find("collision rate 0.28 after the first fit"), std::string::npos) << c[0].screened;
+  EXPECT_NE(c[1].screened.find("40% of the outline"), std::string::npos) << c[1].screened;
+  EXPECT_NE(c[2].screened.find("sees through 25%"), std::string::npos) << c[2].screened;
+  EXPECT_TRUE(c[3].refinable()) << c[3].screened;
+  EXPECT_TRUE(c[4].refinable()) << c[4].screened;
+  EXPECT_TRUE(c[5].screened.empty());  // stage 6 said why already
+  EXPECT_FALSE(c[5].refinable());
+}
+
+TEST(FirstFit, KeepsTheBestTwoStartsOfAnObjectInOnePlace) {
+  const auto banks = twoTenCentimetreObjects();
+  std::vector<PoseCandidate> c;
+  c.push_back(firstFitStart(0, {0.000f, 0, 0.7f}, 0.5f, 0.f, 0.6f));
+  c.push_back(firstFitStart(0, {0.010f, 0, 0.7f}, 0.7f, 0.f, 0.9f));  // best
+  c.push_back(firstFitStart(0, {0.020f, 0, 0.7f}, 0.6f, 0.f, 0.9f));  // second
+  c.push_back(firstFitStart(1, {0.005f, 0, 0.7f}, 0.4f, 0.f, 0.6f));  // another object's place
+  c.push_back(firstFitStart(0, {0.100f, 0, 0.7f}, 0.4f, 0.f, 0.6f));  // 1 diameter away
+  screenStarts(c, banks, 0.3f);
+  EXPECT_NE(c[0].screened.find("2 better starts of cup in the same place"), std::string::npos) << c[0].screened;
+  for (std::size_t i : {1u, 2u, 3u, 4u}) EXPECT_TRUE(c[i].refinable()) << i << ": " << c[i].screened;
+  // 0: all of them go on; with the first fit off, none is tested.
+  for (auto& x : c) x.screened.clear(), x.refine.first_fit_per_place = 0;
+  screenStarts(c, banks, 0.3f);
+  for (const auto& x : c) EXPECT_TRUE(x.refinable()) << x.screened;
+  for (auto& x : c) x.refine.first_fit = false, x.first_evidence.collision.collision_rate = 0.f;
+  screenStarts(c, banks, 0.3f);
+  for (const auto& x : c) EXPECT_TRUE(x.refinable()) << x.screened;
 }
 
 }  // namespace

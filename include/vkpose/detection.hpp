@@ -101,8 +101,9 @@ struct DetectionResult {
   /// those of them in strips the GPU skipped whole (no memory read). 0 without pruning.
   uint64_t match_pairs = 0, match_pairs_pruned = 0, match_pairs_skipped = 0;
   /// Stages 7-8's budget: pose candidates that were refined and verified (stage 6 found scene
-  /// depth under them), and the CPU time they took together (MLS, ICP and verification, each
-  /// candidate timed on its own thread: the cost on one core, whatever the thread count).
+  /// depth under them and the first fit did not stop them), and the CPU time of stages 7-8 of
+  /// every candidate stage 6 placed (first fit, MLS, ICP and verification, each candidate timed
+  /// on its own thread: the cost on one core, whatever the thread count).
   std::size_t refined_candidates = 0;
   double refine_cpu_ms = 0;
   /// Stages 6-8 as a whole: their wall time, the CPU time the process spent meanwhile (all

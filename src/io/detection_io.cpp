@@ -124,6 +124,7 @@ std::string detectionJson(const DetectionResult& result, const DetectionSource& 
   doc["counts"] = {{"matches", result.matches},
                    {"hypotheses", result.hypotheses},
                    {"scored", result.scored_hypotheses},
+                   {"refined", result.refined_candidates},
                    {"rejected", result.rejected.size()},
                    {"detections", result.detections.size()},
                    {"match_pairs", result.match_pairs},

@@ -114,6 +114,12 @@ std::vector<ConfigField> poseFields(DetectorParams& p) {
       {"refine", "min_points", "fewer points after filtering: rejected", &p.refine.min_points},
       {"refine", "fixed_max_correspondence_m", "fixed ICP correspondence distance, metres (0: from the diameter)",
        &p.refine.fixed_max_correspondence_m},
+      {"refine", "first_fit", "test every start after a cheap first fit (coarse ICP, no MLS) before MLS and ICP",
+       &p.refine.first_fit},
+      {"refine", "first_fit_share", "a start goes on when its first fit reaches this share of each of stage 8's limits",
+       &p.refine.first_fit_share},
+      {"refine", "first_fit_per_place", "starts of one object in one place after the first fit that go on (0: all)",
+       &p.refine.first_fit_per_place},
   };
 }
 

@@ -255,7 +255,14 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   attachRenderers();
   initialPoses(candidates, objects_, frame, params_);
   clock.end("initial_pose", result);
-  // Stage 7: MLS smoothing of each crop, then ICP (timed apart: they cost about the same).
+  // Stage 7: a cheap first fit of every start stops those that cannot pass stage 8 and those
+  // with better ones in their place; then MLS smoothing of each crop and ICP (timed apart:
+  // they cost about the same).
+  if (params_.refine.first_fit) {
+    firstFits(candidates, frame, threads);
+    screenStarts(candidates, banks_, params_.duplicate_fraction);
+    clock.end("first_fit", result);
+  }
   smoothSceneCrops(candidates, threads);
   clock.end("mls", result);
   refineCandidates(candidates, threads);
@@ -269,8 +276,11 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   for (auto& c : candidates) resolveNearSymmetries(c, objects_[c.bank()], frame, params_);
   for (auto& c : candidates) resolveLookAlikes(c, objects_[c.bank()], frame, params_);
   const auto symmetries_ms = symmetries.split();
-  for (const auto& c : candidates)
-    if (c.initial.ok) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
+  // Refined: the candidates MLS and ICP ran on; their CPU time includes every first fit.
+  for (const auto& c : candidates) {
+    if (c.refinable()) ++result.refined_candidates;
+    if (c.initial.ok) result.refine_cpu_ms += c.cpu_ms;
+  }
   acceptPoses(candidates, banks_, frame.camera, params_, result);
   clock.end("verification", result, symmetries_ms);
   result.timings_ms.emplace_back("symmetries", symmetries_ms.first);

@@ -69,6 +69,10 @@ void validateRefineParams(const RefineParams& p) {
   if (!std::isfinite(p.fixed_max_correspondence_m) || p.fixed_max_correspondence_m < 0.f)
     throw InputError(fmt::format("fixed max correspondence distance must be >= 0, got {}",
                                  p.fixed_max_correspondence_m));
+  if (!(p.first_fit_share >= 0.f && p.first_fit_share <= 1.f))
+    throw InputError(fmt::format("refine.first_fit_share must be in [0, 1], not {}", p.first_fit_share));
+  if (p.first_fit_per_place < 0)
+    throw InputError(fmt::format("refine.first_fit_per_place must be >= 0 (0: all), not {}", p.first_fit_per_place));
 }
 
 void validateVerifyParams(const VerifyParams& params) {

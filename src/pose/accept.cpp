@@ -57,18 +57,20 @@ void placeInImage(Detection& d, const PointCloud& model_points, const Eigen::Vec
   }
 }
 
-/// The candidate's Detection with its refined pose and stage 8's evidence.
-Detection refinedDetection(const PoseCandidate& c, const TemplateBank& bank, const Camera& camera) {
+/// The candidate's Detection at a fit (its refinement, or its first fit) with stage 8's
+/// evidence there.
+Detection fittedDetection(const PoseCandidate& c, const RefineResult& fit, const PoseEvidence& e,
+                          const TemplateBank& bank, const Camera& camera) {
   Detection d = c.detection;
-  d.pose = c.refined.pose;
-  d.icp_fitness = c.refined.fitness;
-  d.icp_iterations = c.refined.iterations;
-  d.collision_rate = c.evidence.collision.collision_rate;
-  d.see_through = c.evidence.depth.seen_through;
-  d.depth_fit = c.evidence.depth.fits;
-  d.silhouette_support = c.evidence.silhouette_support;
-  d.contour_edges = c.evidence.contour_edges;
-  d.score = poseScore(c.evidence);
+  d.pose = fit.pose;
+  d.icp_fitness = fit.fitness;
+  d.icp_iterations = fit.iterations;
+  d.collision_rate = e.collision.collision_rate;
+  d.see_through = e.depth.seen_through;
+  d.depth_fit = e.depth.fits;
+  d.silhouette_support = e.silhouette_support;
+  d.contour_edges = e.contour_edges;
+  d.score = poseScore(e);
   placeInImage(d, c.initial.model_points, bank.centre, camera);
   return d;
 }
@@ -131,7 +133,7 @@ float poseScore(const PoseEvidence& e) {
   return poseScore(e.collision.collision_rate, e.depth.seen_through, e.silhouette_support);
 }
 
-bool collides(const PoseCandidate& c) { return c.initial.ok && c.evidence.collision.accepted; }
+bool collides(const PoseCandidate& c) { return c.refinable() && c.evidence.collision.accepted; }
 
 bool hopeless(const PoseCandidate& c) {
   return c.evidence.silhouette_support < c.verify.hopeless_support_share * c.verify.min_silhouette_support;
@@ -223,7 +225,13 @@ void acceptPoses(std::vector<PoseCandidate>& candidates, const std::vector<Templ
       result.rejected.push_back(std::move(d));
       continue;
     }
-    Detection d = refinedDetection(c, bank, camera);
+    if (!c.screened.empty()) {  // reported at its first fit, with what was measured there
+      Detection d = fittedDetection(c, c.first_fit, c.first_evidence, bank, camera);
+      d.rejection = c.screened;
+      result.rejected.push_back(std::move(d));
+      continue;
+    }
+    Detection d = fittedDetection(c, c.refined, c.evidence, bank, camera);
     d.rejection = rejectionReason(c, bank.object);
     if (!d.rejection.empty()) {
       result.rejected.push_back(std::move(d));

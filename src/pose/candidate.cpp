@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 
+#include <fmt/format.h>
+
+#include "pose/accept.hpp"
 #include "render/render.hpp"
 #include "util/parallel.hpp"
 #include "util/timing.hpp"
@@ -15,15 +18,16 @@ using util::msSince;
 
 namespace {
 
-/// fn(c) for each candidate that stage 6 placed (initial.ok), on `threads` threads, each
-/// call's time added to the candidate's cpu_ms.
+/// fn(c) for each candidate that `goes_on` (stage 6 placed it, or the first fit did not stop
+/// it either), on `threads` threads, each call's time added to the candidate's cpu_ms.
 template <class Fn>
-void forEachPlaced(std::vector<PoseCandidate>& candidates, unsigned threads, Fn&& fn) {
+void forEachPlaced(std::vector<PoseCandidate>& candidates, unsigned threads, Fn&& fn,
+                   bool (*goes_on)(const PoseCandidate&) = [](const PoseCandidate& c) { return c.refinable(); }) {
   util::parallelFor(
       candidates.size(),
       [&](std::size_t i) {
         PoseCandidate& c = candidates[i];
-        if (!c.initial.ok) return;
+        if (!goes_on(c)) return;
         const auto start = std::chrono::steady_clock::now();
         fn(c);
         c.cpu_ms += msSince(start);
@@ -136,6 +140,80 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
   }
 }
 
+void firstFits(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads) {
+  forEachPlaced(
+      candidates, threads,
+      [&](PoseCandidate& c) {
+        RefineParams unsmoothed = c.refine;
+        unsmoothed.mls = false;
+        c.first_fit = refinePose(c.initial.model_points, c.initial.scene_points, c.initial.pose, unsmoothed,
+                                 FinePoints::Thinned);
+        const PointCloud model = transformed(c.initial.model_points, c.first_fit.pose);
+        PoseEvidence& e = c.first_evidence;
+        e.collision = verifyPose(model, c.initial.scene_points, c.verify);
+        e.depth = depthAgreement(model, frame.depth_m, frame.camera, c.verify.see_through_tolerance);
+        e.silhouette_support = silhouetteSupport(outlineSamples(model, frame.camera, frame.depth_m.size()),
+                                                 frame.depth_m, c.verify.silhouette_jump);
+      },
+      [](const PoseCandidate& c) { return c.initial.ok; });
+}
+
+namespace {
+
+/// The stage 8 limit a first fit falls short of by more than `share`, or empty. The see-through
+/// and silhouette tests stop only a start whose collision rate is below stage 8's limit too:
+/// a large object on a table, pulled by the table in the coarse stage, can see through 25 % of
+/// itself and show a third of its outline at the first fit and pass every test after the fine
+/// stage (synthetic milk cartons), while its collision rate is already above the limit.
+std::string firstFitShortfall(const PoseEvidence& e, const VerifyParams& vp, float share) {
+  const float collision = e.collision.collision_rate;
+  if (collision < share * vp.threshold)
+    return fmt::format("collision rate {:.2f} after the first fit (at least {:.2f} to go on)", collision,
+                       share * vp.threshold);
+  if (collision >= vp.threshold) return {};
+  if (share > 0.f && e.depth.seen_through > vp.max_see_through / share)
+    return fmt::format("the camera sees through {:.0f}% of the model after the first fit (at most {:.0f}% to go on)",
+                       100 * e.depth.seen_through, 100 * vp.max_see_through / share);
+  if (e.silhouette_support < share * vp.min_silhouette_support)
+    return fmt::format("only {:.0f}% of the outline shows a depth step after the first fit (at least {:.0f}% to go on)",
+                       100 * e.silhouette_support, 100 * share * vp.min_silhouette_support);
+  return {};
+}
+
+Eigen::Vector3f placedCentre(const Pose& pose, const TemplateBank& bank) { return pose.R * bank.centre + pose.t; }
+
+}  // namespace
+
+void screenStarts(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
+                  float duplicate_fraction) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    PoseCandidate& c = candidates[i];
+    if (!c.initial.ok || !c.refine.first_fit) continue;
+    c.screened = firstFitShortfall(c.first_evidence, c.verify, c.refine.first_fit_share);
+    if (c.screened.empty()) order.push_back(i);
+  }
+  // Best first; ties keep the stage 6 order, so the result does not depend on the threads.
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return poseScore(candidates[a].first_evidence) > poseScore(candidates[b].first_evidence);
+  });
+  std::vector<std::size_t> going_on;
+  for (const std::size_t i : order) {
+    PoseCandidate& c = candidates[i];
+    const TemplateBank& bank = banks[c.bank()];
+    const Eigen::Vector3f centre = placedCentre(c.first_fit.pose, bank);
+    int better = 0;
+    for (const std::size_t k : going_on)
+      if (candidates[k].bank() == c.bank() &&
+          (placedCentre(candidates[k].first_fit.pose, bank) - centre).norm() < duplicate_fraction * bank.diameter)
+        ++better;
+    if (c.refine.first_fit_per_place > 0 && better >= c.refine.first_fit_per_place)
+      c.screened = fmt::format("{} better starts of {} in the same place after the first fit", better, bank.object);
+    else
+      going_on.push_back(i);
+  }
+}
+
 void smoothSceneCrops(std::vector<PoseCandidate>& candidates, unsigned threads) {
   forEachPlaced(candidates, threads, [](PoseCandidate& c) {
     const RefineParams& rp = c.refine;
@@ -176,7 +254,7 @@ void verifyCandidates(std::vector<PoseCandidate>& candidates, const PoseFrame& f
   util::parallelFor(
       candidates.size(),
       [&](std::size_t i) {
-        if (candidates[i].initial.ok) verifyCandidate(candidates[i], frame);
+        if (candidates[i].refinable()) verifyCandidate(candidates[i], frame);
       },
       threads);
 }

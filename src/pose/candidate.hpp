@@ -3,6 +3,8 @@
 // hypothesis, and each stage is a function that fills in its part of every candidate:
 //   startCandidates    stage 6, rotations: each hypothesis's starts, posed on its viewing ray
 //   initialPoses       stage 6, translations: each start rendered and moved onto the scene
+//   firstFits          stage 7, a cheap first fit of every start (coarse ICP on the raw crop)
+//   screenStarts       stage 7, the starts whose first fit shows they cannot pass stage 8 stop
 //   smoothSceneCrops   stage 7, MLS of each candidate's scene crop
 //   refineCandidates   stage 7, ICP
 //   verifyCandidates   stage 8, the evidence: collision rate, depth agreement, outline tests
@@ -72,11 +74,17 @@ struct PoseCandidate {
   PointCloud smoothed;     ///< stage 7: the scene crop after MLS
   RefineResult refined;    ///< stage 7: ICP's pose
   PoseEvidence evidence;   ///< stage 8
+  RefineResult first_fit;        ///< stage 7's first fit (firstFits)
+  PoseEvidence first_evidence;   ///< stage 8's tests at the first fit (no contour or scene cells)
+  /// Why screenStarts stopped it after the first fit; empty: it goes on to MLS and ICP.
+  std::string screened;
   /// ICP brought it to the pose of a better candidate (markTwins): not compared or accepted.
   bool twin = false;
   double cpu_ms = 0;       ///< stages 7-8's CPU time for this candidate
 
   std::size_t bank() const { return static_cast<std::size_t>(detection.bank); }
+  /// Stage 6 placed it and the first fit did not stop it: MLS, ICP and stage 8 run on it.
+  bool refinable() const { return initial.ok && screened.empty(); }
 };
 
 /// What stages 1-5 know about a hypothesis: its score, image position, best template and box.
@@ -103,6 +111,16 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                   const PoseFrame& frame, const DetectorParams& params);
 
+/// Stage 7, first fit (RefineParams::first_fit): each placed candidate's coarse ICP stage alone
+/// on its unsmoothed crop, and stage 8's collision, depth and silhouette tests at that pose.
+void firstFits(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads);
+
+/// Stage 7, after the first fit: stops (PoseCandidate::screened) each start whose first fit
+/// falls short of first_fit_share of a stage 8 limit, and each one with first_fit_per_place
+/// better starts of its object in its place (closer than duplicate_fraction of the diameter).
+void screenStarts(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
+                  float duplicate_fraction);
+
 /// Stage 7, first step: each candidate's scene crop smoothed by MLS (RefineParams::mls).
 void smoothSceneCrops(std::vector<PoseCandidate>& candidates, unsigned threads);
 
@@ -117,7 +135,7 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
 /// to cpu_ms.
 void verifyCandidate(PoseCandidate& candidate, const PoseFrame& frame);
 
-/// Stage 8: verifyCandidate for every candidate that stage 6 placed.
+/// Stage 8: verifyCandidate for every refinable candidate.
 void verifyCandidates(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads);
 
 }  // namespace vkpose

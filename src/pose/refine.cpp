@@ -246,7 +246,7 @@ PointCloud smoothMlsPcl(const PointCloud& scene, float radius, int order, float 
 }
 
 RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_points, const Pose& initial,
-                        const RefineParams& params) {
+                        const RefineParams& params, FinePoints fine_points) {
   validateRefineParams(params);
   RefineResult result;
   result.pose = initial;
@@ -291,15 +291,17 @@ RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_
     // at a fraction of the pairing (coarse_max_points). The fine stage runs even when the
     // coarse one hit its limit: it starts closer anyway.
     const auto limit = static_cast<std::size_t>(params.coarse_max_points);
+    Cloud::Ptr thinned = model;
     if (limit > 0 && model->size() > limit) {
       const std::size_t k = (model->size() + limit - 1) / limit;
-      auto thinned = pcl::make_shared<Cloud>();
-      for (std::size_t i = 0; i < model->size(); i += k) thinned->push_back((*model)[i]);
-      if (thinned->size() >= min_points) icp.setModel(thinned);
+      auto every_kth = pcl::make_shared<Cloud>();
+      for (std::size_t i = 0; i < model->size(); i += k) every_kth->push_back((*model)[i]);
+      if (every_kth->size() >= min_points) thinned = every_kth;
     }
+    icp.setModel(thinned);
     result.coarse_converged = icp.stage(params.coarse_fraction, params.coarse_iterations,
                                         params.convergence_epsilon, cam_T_model, result.iterations);
-    icp.setModel(model);
+    if (fine_points == FinePoints::All) icp.setModel(model);
     const bool fine = icp.stage(params.fine_fraction, params.fine_iterations, params.convergence_epsilon,
                                 cam_T_model, result.iterations);
     result.converged = params.fine_iterations > 0 ? fine : result.coarse_converged;  // 0: stage skipped

@@ -29,6 +29,11 @@ struct RefineResult {
   double mls_ms = 0, voxel_ms = 0, icp_ms = 0;     ///< time per step
 };
 
+/// The model points ICP's fine stage pairs: all of them (the refinement), or the coarse stage's
+/// thinned ones (RefineParams::coarse_max_points; the first fit: a fifth of the pairing, and
+/// near enough to where the full fit ends to judge a start by).
+enum class FinePoints { All, Thinned };
+
 /// Refines `initial` so that `model_points` (object frame, metres) fall onto `scene_points`
 /// (camera-frame crop, metres). Pass the model's surface as seen from about the initial pose
 /// (rendered there and moved to the object frame), as stage 6 has it: with all mesh vertices,
@@ -39,7 +44,7 @@ struct RefineResult {
 /// nonsense parameters (negative sizes, fractions outside (0, 1]). Thread-safe: all state is
 /// local to the call.
 RefineResult refinePose(const PointCloud& model_points, const PointCloud& scene_points, const Pose& initial,
-                        const RefineParams& params = {});
+                        const RefineParams& params = {}, FinePoints fine_points = FinePoints::All);
 
 /// Moving least squares: each point projected onto a polynomial of `order` fitted to its
 /// neighbours within `radius` (metres), weighted by exp(-d^2 / radius^2) (PCL's
