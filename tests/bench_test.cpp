@@ -122,7 +122,11 @@ TEST(BenchDetect, OneSyntheticFrameReportsEveryStage) {
   double sum = 0;
   for (std::size_t i = 0; i < stages.size(); ++i) {
     EXPECT_EQ(r.stages[i].stage, stages[i]);
-    EXPECT_GT(r.stages[i].median_ms, 0.0) << stages[i] << " took no time: not timed?";
+    // MLS and ICP run in rounds over the candidates the first fit passed: none, no time.
+    const bool idle = r.mean_refined == 0 && (stages[i] == "mls" || stages[i] == "icp");
+    if (!idle) {
+      EXPECT_GT(r.stages[i].median_ms, 0.0) << stages[i] << " took no time: not timed?";
+    }
     EXPECT_DOUBLE_EQ(r.stages[i].median_ms, r.stages[i].p95_ms);  // one frame: one value
     if (i + 1 < stages.size()) sum += r.stages[i].median_ms;
   }

@@ -300,7 +300,8 @@ TEST(InitialTranslation, ABlackHoleIsRejectedWithAReason) {
 }
 
 /// A start whose first fit put the object's centre at `t` with these measurements.
-PoseCandidate firstFitStart(int bank, const Eigen::Vector3f& t, float collision, float see_through, float silhouette) {
+PoseCandidate firstFitStart(int bank, const Eigen::Vector3f& t, float collision, float see_through, float silhouette,
+                            float contour = 1.f) {
   PoseCandidate c;
   c.detection.bank = bank;
   c.initial.ok = true;
@@ -308,7 +309,19 @@ PoseCandidate firstFitStart(int bank, const Eigen::Vector3f& t, float collision,
   c.first_evidence.collision.collision_rate = collision;
   c.first_evidence.depth.seen_through = see_through;
   c.first_evidence.silhouette_support = silhouette;
-  return c;  // RefineParams and VerifyParams at their defaults: share 0.75, two a place
+  c.first_evidence.contour_edges = contour;
+  // RefineParams and VerifyParams at their defaults: share 0.75 (contour 0.6), two a place.
+  c.first_fit_min_collision = c.refine.first_fit_share * c.verify.threshold;
+  return c;
+}
+
+/// Stage 8's measurements, passing every test or failing the collision test.
+void measure(PoseCandidate& c, bool passes) {
+  c.measured = true;
+  c.evidence.collision.accepted = passes;
+  c.evidence.collision.collision_rate = passes ? 0.8f : 0.2f;
+  c.evidence.silhouette_support = 1.f;
+  c.evidence.contour_edges = 1.f;
 }
 
 std::vector<TemplateBank> twoTenCentimetreObjects() {
@@ -320,46 +333,69 @@ std::vector<TemplateBank> twoTenCentimetreObjects() {
 }
 
 TEST(FirstFit, StopsStartsShortOfStageEightsLimitsAndSaysWhy) {
-  const auto banks = twoTenCentimetreObjects();
   std::vector<PoseCandidate> c;
   c.push_back(firstFitStart(0, {0.0f, 0, 0.7f}, 0.28f, 0.0f, 1.0f));   // collision under 0.75 x 0.4
   c.push_back(firstFitStart(0, {0.2f, 0, 0.7f}, 0.35f, 0.0f, 0.40f));  // silhouette under 0.75 x 0.55
   c.push_back(firstFitStart(0, {0.4f, 0, 0.7f}, 0.35f, 0.25f, 0.9f));  // sees through more than 0.15 / 0.75
   c.push_back(firstFitStart(0, {0.6f, 0, 0.7f}, 0.35f, 0.1f, 0.5f));   // near enough on every test
-  // At the limit's collision rate the other two tests wait for MLS and ICP (a carton the
-  // table pulled aside in the first fit).
+  // Above the limit's collision rate and seeing through itself: pulled aside by a table in
+  // the first fit, its outline tests wait for MLS and ICP.
   c.push_back(firstFitStart(0, {0.8f, 0, 0.7f}, 0.45f, 0.25f, 0.2f));
-  PoseCandidate unplaced = firstFitStart(0, {1.0f, 0, 0.7f}, 0.f, 1.f, 0.f);
+  // Above the limit but lying on the scene's surfaces without a depth step at its outline.
+  c.push_back(firstFitStart(0, {1.0f, 0, 0.7f}, 0.55f, 0.01f, 0.2f));
+  c.push_back(firstFitStart(0, {1.2f, 0, 0.7f}, 0.55f, 0.0f, 0.9f, 0.2f));  // image edges under 0.6 x 0.45
+  PoseCandidate second_try = firstFitStart(0, {1.4f, 0, 0.7f}, 0.45f, 0.0f, 0.9f);
+  second_try.verify.threshold = 0.6f;
+  second_try.first_fit_min_collision = 0.5f;  // 0.6 less the plain limit's margin, 0.25 x 0.4
+  c.push_back(second_try);
+  PoseCandidate unplaced = firstFitStart(0, {1.6f, 0, 0.7f}, 0.f, 1.f, 0.f);
   unplaced.initial.ok = false;
   c.push_back(unplaced);
-  screenStarts(c, banks, 0.3f);
+  screenStarts(c);
   EXPECT_NE(c[0].screened.find("collision rate 0.28 after the first fit"), std::string::npos) << c[0].screened;
   EXPECT_NE(c[1].screened.find("40% of the outline"), std::string::npos) << c[1].screened;
   EXPECT_NE(c[2].screened.find("sees through 25%"), std::string::npos) << c[2].screened;
   EXPECT_TRUE(c[3].refinable()) << c[3].screened;
   EXPECT_TRUE(c[4].refinable()) << c[4].screened;
-  EXPECT_TRUE(c[5].screened.empty());  // stage 6 said why already
-  EXPECT_FALSE(c[5].refinable());
+  EXPECT_NE(c[5].screened.find("20% of the outline"), std::string::npos) << c[5].screened;
+  EXPECT_NE(c[6].screened.find("20% of its visible outline meets an edge"), std::string::npos) << c[6].screened;
+  EXPECT_NE(c[7].screened.find("at least 0.50 to go on"), std::string::npos) << c[7].screened;
+  EXPECT_TRUE(c[8].screened.empty());  // stage 6 said why already
+  EXPECT_FALSE(c[8].refinable());
 }
 
-TEST(FirstFit, KeepsTheBestTwoStartsOfAnObjectInOnePlace) {
+TEST(FirstFit, KeepsTheBestTwoOfAnObjectInAPlaceAndLetsAnotherObjectWaitForThem) {
   const auto banks = twoTenCentimetreObjects();
   std::vector<PoseCandidate> c;
   c.push_back(firstFitStart(0, {0.000f, 0, 0.7f}, 0.5f, 0.f, 0.6f));
   c.push_back(firstFitStart(0, {0.010f, 0, 0.7f}, 0.7f, 0.f, 0.9f));  // best
   c.push_back(firstFitStart(0, {0.020f, 0, 0.7f}, 0.6f, 0.f, 0.9f));  // second
-  c.push_back(firstFitStart(1, {0.005f, 0, 0.7f}, 0.4f, 0.f, 0.6f));  // another object's place
+  c.push_back(firstFitStart(1, {0.005f, 0, 0.7f}, 0.4f, 0.f, 0.6f));  // another object in that place
   c.push_back(firstFitStart(0, {0.100f, 0, 0.7f}, 0.4f, 0.f, 0.6f));  // 1 diameter away
-  screenStarts(c, banks, 0.3f);
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{1, 2, 4}));
   EXPECT_NE(c[0].screened.find("2 better starts of cup in the same place"), std::string::npos) << c[0].screened;
-  for (std::size_t i : {1u, 2u, 3u, 4u}) EXPECT_TRUE(c[i].refinable()) << i << ": " << c[i].screened;
-  // 0: all of them go on; with the first fit off, none is tested.
-  for (auto& x : c) x.screened.clear(), x.refine.first_fit_per_place = 0;
-  screenStarts(c, banks, 0.3f);
-  for (const auto& x : c) EXPECT_TRUE(x.refinable()) << x.screened;
-  for (auto& x : c) x.refine.first_fit = false, x.first_evidence.collision.collision_rate = 0.f;
-  screenStarts(c, banks, 0.3f);
-  for (const auto& x : c) EXPECT_TRUE(x.refinable()) << x.screened;
+  EXPECT_TRUE(c[3].screened.empty()) << c[3].screened;  // waits for the cups
+  measure(c[1], false);
+  measure(c[2], true);
+  measure(c[4], true);
+  EXPECT_TRUE(nextRound(c, banks, 0.3f).empty());  // a cup passed: the carton would lose the place
+  EXPECT_NE(c[3].screened.find("a better start of cup in the same place passed stage 8"), std::string::npos)
+      << c[3].screened;
+  // Had both cups failed, the carton would have gone next.
+  for (auto& x : c) x.screened.clear(), x.measured = false;
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{1, 2, 4}));
+  measure(c[1], false);
+  measure(c[2], false);
+  measure(c[4], true);
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{3}));
+  // 0: every start of an object goes.
+  for (auto& x : c) x.screened.clear(), x.measured = false, x.refine.first_fit_per_place = 0;
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{0, 1, 2, 4}));
+  // With the first fit off, every placed start goes in one round.
+  for (auto& x : c) x.screened.clear(), x.measured = false, x.refine.first_fit = false;
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+  for (auto& x : c) measure(x, false);
+  EXPECT_TRUE(nextRound(c, banks, 0.3f).empty());
 }
 
 }  // namespace

@@ -187,23 +187,38 @@ struct RefineParams {
   float fixed_max_correspondence_m = 0.f;
   /// The first fit, a cheap test of every start before MLS and ICP: both ICP stages on the
   /// unsmoothed crop with the coarse stage's thinned model points (about a third of a
-  /// refinement's CPU time), then stage 8's collision rate, see-through share and silhouette
-  /// support at that pose. At stage 6's pose these tests tell nothing (a later detection's
+  /// refinement's CPU time), then stage 8's collision rate, see-through share, silhouette
+  /// support and image-edge support at that pose. At stage 6's pose these tests tell nothing (a later detection's
   /// start had a collision rate from 0.05); after the first fit they come close to the final
   /// ones (docs/pipeline.md, stage 7). false: every start is refined.
   bool first_fit = true;
   /// A start goes on to MLS and ICP when its first fit reaches this share of stage 8's limits:
-  /// a collision rate of share x verify.threshold, and, where the rate is below the limit
-  /// itself, a silhouette support of share x verify.min_silhouette_support and at most
-  /// verify.max_see_through / share seen through (a large object pulled by the table it stands
-  /// on can fail these two at the first fit and pass after MLS and ICP). The collision rate
-  /// there runs lower than after MLS (an L-shaped part: 0.34 at the first fit, 0.66 refined),
-  /// so 0.85 lost detections where 0.75 kept every one (IC-BIN, LM-O, synthetic sets).
+  /// a collision rate of share x verify.threshold (a start that needs the raised rate of a
+  /// second try, that rate less the same margin), a silhouette support of share x
+  /// verify.min_silhouette_support and at most verify.max_see_through / share seen through.
+  /// The collision rate there runs lower than after MLS (an L-shaped part: 0.34 at the first
+  /// fit, 0.66 refined), so 0.85 lost detections where 0.75 kept every one (IC-BIN, LM-O,
+  /// synthetic sets).
   float first_fit_share = 0.75f;
-  /// Of the starts of one object whose first fits put its centre in one place (closer than
+  /// ... and an image edge under first_fit_contour_share x verify.min_contour_edges of its
+  /// visible outline: lower than the other tests' share because a symmetric carton's first fit
+  /// can lie half a turn from the pose stage 8 settles on (a milk carton: 0.32 at the first fit,
+  /// 0.93 turned).
+  float first_fit_contour_share = 0.6f;
+  /// A start above the collision limit whose first fit sees through at least this share of
+  /// the model counts as pulled aside by a larger surface (a carton by the table it stands
+  /// on: a third of its outline at the first fit, all of it after MLS and ICP), and its
+  /// silhouette and see-through tests wait for stage 8. One that sees through less lies on the
+  /// scene's surfaces already, and an outline without depth steps there stays without them
+  /// (LM-O: 20 such starts of four objects, none a detection after MLS and ICP).
+  float first_fit_pulled_see_through = 0.05f;
+  /// Of the starts whose first fits put an object's centre in one place (closer than
   /// detector.duplicate_fraction of the diameter), this many go on, the best by stage 8's score
   /// at the first fit; only one of them can be a detection, and the first fit's ranking is not
-  /// the final one (1 lost an LM-O detection). 0: all of them.
+  /// the final one (1 lost an LM-O detection; refining the second only where the first failed
+  /// stage 8 cost synthetic cartons their better pose). 0: all of them. A start in the place
+  /// of a better start of another object (the smaller diameter's place) waits for it and stops
+  /// if it passed stage 8: it would lose the place to it.
   int first_fit_per_place = 2;
 };
 /// Throws InputError naming the bad value.

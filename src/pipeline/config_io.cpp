@@ -118,7 +118,14 @@ std::vector<ConfigField> poseFields(DetectorParams& p) {
        &p.refine.first_fit},
       {"refine", "first_fit_share", "a start goes on when its first fit reaches this share of each of stage 8's limits",
        &p.refine.first_fit_share},
-      {"refine", "first_fit_per_place", "starts of one object in one place after the first fit that go on (0: all)",
+      {"refine", "first_fit_contour_share",
+       "a start goes on when its first fit's image-edge support reaches this share of verify.min_contour_edges",
+       &p.refine.first_fit_contour_share},
+      {"refine", "first_fit_pulled_see_through",
+       "a start above the collision limit seeing through this share at its first fit waits for stage 8's outline tests",
+       &p.refine.first_fit_pulled_see_through},
+      {"refine", "first_fit_per_place",
+       "starts of one object in one place after the first fit that go on (0: all)",
        &p.refine.first_fit_per_place},
   };
 }

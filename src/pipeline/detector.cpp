@@ -255,22 +255,37 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   attachRenderers();
   initialPoses(candidates, objects_, frame, params_);
   clock.end("initial_pose", result);
-  // Stage 7: a cheap first fit of every start stops those that cannot pass stage 8 and those
-  // with better ones in their place; then MLS smoothing of each crop and ICP (timed apart:
-  // they cost about the same).
+  // Stage 7: a cheap first fit of every start stops those that cannot pass stage 8; then MLS
+  // smoothing of each crop and ICP (timed apart: they cost about the same), and stage 8's
+  // measurements, in rounds: the best start of each place first, the next only where it
+  // failed (nextRound).
   if (params_.refine.first_fit) {
     firstFits(candidates, frame, threads);
-    screenStarts(candidates, banks_, params_.duplicate_fraction);
+    screenStarts(candidates);
     clock.end("first_fit", result);
   }
-  smoothSceneCrops(candidates, threads);
-  clock.end("mls", result);
-  refineCandidates(candidates, threads);
-  clock.end("icp", result);
-  // Stage 8: the collision rate and the depth and outline tests; the poses that pass are
-  // rendered against their near-symmetric turns and look-alikes (twins of better ones
-  // spared), then accepted or rejected, and the accepted compete for places and the scene.
-  verifyCandidates(candidates, frame, threads);
+  std::pair<double, double> mls_ms, icp_ms, measure_ms;
+  const auto add = [](std::pair<double, double>& sum, std::pair<double, double> ms) {
+    sum.first += ms.first;
+    sum.second += ms.second;
+  };
+  for (auto round = nextRound(candidates, banks_, params_.duplicate_fraction); !round.empty();
+       round = nextRound(candidates, banks_, params_.duplicate_fraction)) {
+    smoothSceneCrops(candidates, round, threads);
+    add(mls_ms, clock.split());
+    refineCandidates(candidates, round, threads);
+    add(icp_ms, clock.split());
+    verifyCandidates(candidates, round, frame, threads);
+    add(measure_ms, clock.split());
+  }
+  for (const auto& [stage, ms] : {std::pair{"mls", mls_ms}, std::pair{"icp", icp_ms}}) {
+    result.timings_ms.emplace_back(stage, ms.first);
+    result.kernel_ms.emplace_back(stage, ms.second);
+  }
+  // Stage 8: the collision rate and the depth and outline tests (measured above); the poses
+  // that pass are rendered against their near-symmetric turns and look-alikes (twins of
+  // better ones spared), then accepted or rejected, and the accepted compete for places and
+  // the scene.
   StageClock symmetries(ctx_);
   markTwins(candidates, banks_, params_.verify);
   for (auto& c : candidates) resolveNearSymmetries(c, objects_[c.bank()], frame, params_);
@@ -278,11 +293,11 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   const auto symmetries_ms = symmetries.split();
   // Refined: the candidates MLS and ICP ran on; their CPU time includes every first fit.
   for (const auto& c : candidates) {
-    if (c.refinable()) ++result.refined_candidates;
+    if (c.measured) ++result.refined_candidates;
     if (c.initial.ok) result.refine_cpu_ms += c.cpu_ms;
   }
   acceptPoses(candidates, banks_, frame.camera, params_, result);
-  clock.end("verification", result, symmetries_ms);
+  clock.end("verification", result, {symmetries_ms.first - measure_ms.first, symmetries_ms.second - measure_ms.second});
   result.timings_ms.emplace_back("symmetries", symmetries_ms.first);
   result.kernel_ms.emplace_back("symmetries", symmetries_ms.second);
   result.pose_wall_ms = msSince(wall0);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -69,8 +70,11 @@ void validateRefineParams(const RefineParams& p) {
   if (!std::isfinite(p.fixed_max_correspondence_m) || p.fixed_max_correspondence_m < 0.f)
     throw InputError(fmt::format("fixed max correspondence distance must be >= 0, got {}",
                                  p.fixed_max_correspondence_m));
-  if (!(p.first_fit_share >= 0.f && p.first_fit_share <= 1.f))
-    throw InputError(fmt::format("refine.first_fit_share must be in [0, 1], not {}", p.first_fit_share));
+  for (const auto& [name, value] : {std::pair{"first_fit_share", p.first_fit_share},
+                                    std::pair{"first_fit_contour_share", p.first_fit_contour_share},
+                                    std::pair{"first_fit_pulled_see_through", p.first_fit_pulled_see_through}})
+    if (!(value >= 0.f && value <= 1.f))
+      throw InputError(fmt::format("refine.{} must be in [0, 1], not {}", name, value));
   if (p.first_fit_per_place < 0)
     throw InputError(fmt::format("refine.first_fit_per_place must be >= 0 (0: all), not {}", p.first_fit_per_place));
 }

@@ -133,7 +133,7 @@ float poseScore(const PoseEvidence& e) {
   return poseScore(e.collision.collision_rate, e.depth.seen_through, e.silhouette_support);
 }
 
-bool collides(const PoseCandidate& c) { return c.refinable() && c.evidence.collision.accepted; }
+bool collides(const PoseCandidate& c) { return c.measured && c.evidence.collision.accepted; }
 
 bool hopeless(const PoseCandidate& c) {
   return c.evidence.silhouette_support < c.verify.hopeless_support_share * c.verify.min_silhouette_support;
@@ -166,12 +166,10 @@ void markTwins(std::vector<PoseCandidate>& candidates, const std::vector<Templat
   }
 }
 
-std::string rejectionReason(const PoseCandidate& c, const std::string& object) {
+std::string stageEightShortfall(const PoseCandidate& c) {
   const VerifyParams& vp = c.verify;
-  const Detection& d = c.detection;
   const PoseEvidence& e = c.evidence;
   const float see_through = e.depth.seen_through;
-  if (c.twin) return fmt::format("the same pose as a better {} candidate", object);
   if (!e.collision.accepted)
     return fmt::format("collision rate {:.2f} is not above {:.2f}", e.collision.collision_rate, vp.threshold);
   if (see_through > vp.max_see_through)
@@ -184,6 +182,14 @@ std::string rejectionReason(const PoseCandidate& c, const std::string& object) {
     return fmt::format("only {:.0f}% of its visible outline meets an edge in the image (at least {:.0f}%): "
                        "something else of its size?",
                        100 * e.contour_edges, 100 * vp.min_contour_edges);
+  return {};
+}
+
+std::string rejectionReason(const PoseCandidate& c, const std::string& object) {
+  const VerifyParams& vp = c.verify;
+  const Detection& d = c.detection;
+  if (c.twin) return fmt::format("the same pose as a better {} candidate", object);
+  if (std::string shortfall = stageEightShortfall(c); !shortfall.empty()) return shortfall;
   if (d.colour_agreement < vp.min_colour_agreement)
     return fmt::format("its colours do not match the scene's (agreement {:.2f}, at least {:.2f}): "
                        "something else of its shape?",

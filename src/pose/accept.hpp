@@ -31,6 +31,11 @@ bool hopeless(const PoseCandidate& c);
 void markTwins(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
                const VerifyParams& params);
 
+/// The first of stage 8's tests of the measured pose that a candidate fails (the collision
+/// rate, the share seen through, the outline's depth steps and image edges), or empty. The
+/// rounds of refinement (nextRound) ask it; rejectionReason adds the twin and colour rules.
+std::string stageEightShortfall(const PoseCandidate& c);
+
 /// Why a verified candidate is rejected, in the order the rules are tried; empty when accepted.
 std::string rejectionReason(const PoseCandidate& c, const std::string& object);
 

@@ -3,9 +3,10 @@
 // hypothesis, and each stage is a function that fills in its part of every candidate:
 //   startCandidates    stage 6, rotations: each hypothesis's starts, posed on its viewing ray
 //   initialPoses       stage 6, translations: each start rendered and moved onto the scene
-//   firstFits          stage 7, a cheap first fit of every start (coarse ICP on the raw crop)
+//   firstFits          stage 7, a cheap first fit of every start (ICP on the raw crop)
 //   screenStarts       stage 7, the starts whose first fit shows they cannot pass stage 8 stop
-//   smoothSceneCrops   stage 7, MLS of each candidate's scene crop
+//   nextRound          stage 7, the starts refined next: another object's better one first
+//   smoothSceneCrops   stage 7, MLS of each of a round's scene crops
 //   refineCandidates   stage 7, ICP
 //   verifyCandidates   stage 8, the evidence: collision rate, depth agreement, outline tests
 // then alternatives.hpp (near-symmetries, look-alikes) and accept.hpp (the acceptance rules and
@@ -75,15 +76,19 @@ struct PoseCandidate {
   RefineResult refined;    ///< stage 7: ICP's pose
   PoseEvidence evidence;   ///< stage 8
   RefineResult first_fit;        ///< stage 7's first fit (firstFits)
-  PoseEvidence first_evidence;   ///< stage 8's tests at the first fit (no contour or scene cells)
-  /// Why screenStarts stopped it after the first fit; empty: it goes on to MLS and ICP.
+  PoseEvidence first_evidence;   ///< stage 8's tests at the first fit (no scene cells)
+  /// The collision rate its first fit needs to go on (initialPoses; RefineParams::first_fit_share).
+  float first_fit_min_collision = 0.f;
+  /// Why the first fit stopped it (screenStarts, nextRound); empty: it goes on to MLS and ICP.
   std::string screened;
+  bool measured = false;   ///< stage 8 measured its refined pose (verifyCandidate)
   /// ICP brought it to the pose of a better candidate (markTwins): not compared or accepted.
   bool twin = false;
   double cpu_ms = 0;       ///< stages 7-8's CPU time for this candidate
 
   std::size_t bank() const { return static_cast<std::size_t>(detection.bank); }
-  /// Stage 6 placed it and the first fit did not stop it: MLS, ICP and stage 8 run on it.
+  /// Stage 6 placed it and the first fit did not stop it: MLS, ICP and stage 8 run on it (or
+  /// will, in a later round).
   bool refinable() const { return initial.ok && screened.empty(); }
 };
 
@@ -111,31 +116,46 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                   const PoseFrame& frame, const DetectorParams& params);
 
-/// Stage 7, first fit (RefineParams::first_fit): each placed candidate's coarse ICP stage alone
-/// on its unsmoothed crop, and stage 8's collision, depth and silhouette tests at that pose.
+/// Stage 7, first fit (RefineParams::first_fit): each placed candidate's two ICP stages with
+/// the coarse stage's thinned model points on its unsmoothed crop, and stage 8's measurements
+/// at that pose (first_evidence).
 void firstFits(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads);
 
 /// Stage 7, after the first fit: stops (PoseCandidate::screened) each start whose first fit
-/// falls short of first_fit_share of a stage 8 limit, and each one with first_fit_per_place
-/// better starts of its object in its place (closer than duplicate_fraction of the diameter).
-void screenStarts(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
-                  float duplicate_fraction);
+/// falls short of a stage 8 limit by more than RefineParams::first_fit_share allows (the
+/// image-edge support: first_fit_contour_share).
+void screenStarts(std::vector<PoseCandidate>& candidates);
 
-/// Stage 7, first step: each candidate's scene crop smoothed by MLS (RefineParams::mls).
-void smoothSceneCrops(std::vector<PoseCandidate>& candidates, unsigned threads);
+/// Stage 7, the next round of refinement: the indices of the candidates that MLS, ICP and
+/// stage 8 take next. Without the first fit, every placed one in one round. With it, ranked
+/// by stage 8's score at the first fit, a start stops (screened) where first_fit_per_place
+/// better starts of its object lie in its place (centres closer than duplicate_fraction of
+/// the diameter) or where a better start of another object (the smaller diameter's place)
+/// passed stage 8's tests (stageEightShortfall); it waits while such a start is not measured
+/// yet, and goes otherwise. Empty when every placed candidate is measured or stopped. The
+/// rounds depend on the measurements only, never on the threads.
+std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
+                                   float duplicate_fraction);
 
-/// Stage 7, second step: ICP of each candidate's model points onto its smoothed crop.
-void refineCandidates(std::vector<PoseCandidate>& candidates, unsigned threads);
+/// Stage 7, first step: the round's candidates' scene crops smoothed by MLS (RefineParams::mls).
+void smoothSceneCrops(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& round,
+                      unsigned threads);
 
-/// Stage 8's measurements of `model_points` (object frame) at `pose` against the scene.
+/// Stage 7, second step: ICP of each of the round's model points onto its smoothed crop.
+void refineCandidates(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& round,
+                      unsigned threads);
+
+/// Stage 8's measurements of `model_points` (object frame) at `pose` against the scene; the
+/// scene cells it explains (PoseEvidence::explained) only with `with_cells`.
 PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const PointCloud& scene_points,
-                         const PoseFrame& frame, const VerifyParams& params);
+                         const PoseFrame& frame, const VerifyParams& params, bool with_cells = true);
 
 /// Stage 8: a refined candidate's evidence (measurePose at its refined pose), its time added
 /// to cpu_ms.
 void verifyCandidate(PoseCandidate& candidate, const PoseFrame& frame);
 
-/// Stage 8: verifyCandidate for every refinable candidate.
-void verifyCandidates(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, unsigned threads);
+/// Stage 8: verifyCandidate for each of the round's candidates.
+void verifyCandidates(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& round,
+                      const PoseFrame& frame, unsigned threads);
 
 }  // namespace vkpose
