@@ -72,6 +72,7 @@ void validateRefineParams(const RefineParams& p) {
                                  p.fixed_max_correspondence_m));
   for (const auto& [name, value] : {std::pair{"first_fit_share", p.first_fit_share},
                                     std::pair{"first_fit_contour_share", p.first_fit_contour_share},
+                                    std::pair{"first_fit_silhouette_share", p.first_fit_silhouette_share},
                                     std::pair{"first_fit_pulled_see_through", p.first_fit_pulled_see_through}})
     if (!(value >= 0.f && value <= 1.f))
       throw InputError(fmt::format("refine.{} must be in [0, 1], not {}", name, value));

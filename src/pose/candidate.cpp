@@ -183,9 +183,9 @@ std::string firstFitShortfall(const PoseCandidate& c) {
   if (share > 0.f && e.depth.seen_through > vp.max_see_through / share)
     return fmt::format("the camera sees through {:.0f}% of the model after the first fit (at most {:.0f}% to go on)",
                        100 * e.depth.seen_through, 100 * vp.max_see_through / share);
-  if (e.silhouette_support < share * vp.min_silhouette_support)
+  if (e.silhouette_support < rp.first_fit_silhouette_share * vp.min_silhouette_support)
     return fmt::format("only {:.0f}% of the outline shows a depth step after the first fit (at least {:.0f}% to go on)",
-                       100 * e.silhouette_support, 100 * share * vp.min_silhouette_support);
+                       100 * e.silhouette_support, 100 * rp.first_fit_silhouette_share * vp.min_silhouette_support);
   return {};
 }
 
