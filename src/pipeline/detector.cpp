@@ -257,8 +257,8 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   clock.end("initial_pose", result);
   // Stage 7: a cheap first fit of every start stops those that cannot pass stage 8; then MLS
   // smoothing of each crop and ICP (timed apart: they cost about the same), and stage 8's
-  // measurements, in rounds: the best start of each place first, the next only where it
-  // failed (nextRound).
+  // measurements, in rounds: a start in the place of another object's better start waits
+  // for its stage 8 (nextRound).
   if (params_.refine.first_fit) {
     firstFits(candidates, frame, threads);
     screenStarts(candidates);
@@ -297,6 +297,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     if (c.initial.ok) result.refine_cpu_ms += c.cpu_ms;
   }
   acceptPoses(candidates, banks_, frame.camera, params_, result);
+  // Verification: its measurements in the rounds, plus this, less the symmetries timed apart.
   clock.end("verification", result, {symmetries_ms.first - measure_ms.first, symmetries_ms.second - measure_ms.second});
   result.timings_ms.emplace_back("symmetries", symmetries_ms.first);
   result.kernel_ms.emplace_back("symmetries", symmetries_ms.second);

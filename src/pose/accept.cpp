@@ -27,13 +27,10 @@ float sameObjectRank(const Detection& d) {
   return chosen < alts.size() ? d.score * alts[chosen].score : d.score;
 }
 
-/// Whether two poses' centres lie closer than duplicate_fraction of the smaller diameter.
 bool samePlace(const Detection& a, const Detection& b, const std::vector<TemplateBank>& banks,
                float duplicate_fraction) {
-  const TemplateBank& ba = banks.at(static_cast<std::size_t>(a.bank));
-  const TemplateBank& bb = banks.at(static_cast<std::size_t>(b.bank));
-  const Eigen::Vector3f ca = placed(a.pose, ba.centre), cb = placed(b.pose, bb.centre);
-  return (ca - cb).norm() < duplicate_fraction * std::min(ba.diameter, bb.diameter);
+  return samePlace(a.pose, static_cast<std::size_t>(a.bank), b.pose, static_cast<std::size_t>(b.bank), banks,
+                   duplicate_fraction);
 }
 
 /// The image box and centre of the posed visible model.
@@ -124,6 +121,13 @@ void competeForScene(std::vector<Detection>& accepted, const std::vector<std::ve
 }
 
 }  // namespace
+
+bool samePlace(const Pose& a, std::size_t bank_a, const Pose& b, std::size_t bank_b,
+               const std::vector<TemplateBank>& banks, float duplicate_fraction) {
+  const TemplateBank& ba = banks.at(bank_a);
+  const TemplateBank& bb = banks.at(bank_b);
+  return (placed(a, ba.centre) - placed(b, bb.centre)).norm() < duplicate_fraction * std::min(ba.diameter, bb.diameter);
+}
 
 float poseScore(float collision_rate, float see_through, float silhouette_support) {
   return collision_rate * (1.f - see_through) * silhouette_support;

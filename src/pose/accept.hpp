@@ -12,6 +12,12 @@
 
 namespace vkpose {
 
+/// Whether two poses put their objects' centres (the banks' centres) closer than
+/// duplicate_fraction of the smaller diameter: one place, for stage 8's duplicates and for the
+/// first fit's rounds.
+bool samePlace(const Pose& a, std::size_t bank_a, const Pose& b, std::size_t bank_b,
+               const std::vector<TemplateBank>& banks, float duplicate_fraction);
+
 /// A verified pose's score: the collision rate, times the share not seen through, times the
 /// outline's support (Detection::score).
 float poseScore(float collision_rate, float see_through, float silhouette_support);

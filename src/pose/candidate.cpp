@@ -189,18 +189,6 @@ std::string firstFitShortfall(const PoseCandidate& c) {
   return {};
 }
 
-Eigen::Vector3f placedCentre(const Pose& pose, const TemplateBank& bank) { return pose.R * bank.centre + pose.t; }
-
-/// Whether two first fits put their objects' centres in one place: closer than
-/// duplicate_fraction of the diameter (the smaller one between two objects).
-bool onePlace(const PoseCandidate& a, const PoseCandidate& b, const std::vector<TemplateBank>& banks,
-              float duplicate_fraction) {
-  const TemplateBank& ba = banks[a.bank()];
-  const TemplateBank& bb = banks[b.bank()];
-  return (placedCentre(a.first_fit.pose, ba) - placedCentre(b.first_fit.pose, bb)).norm() <
-         duplicate_fraction * std::min(ba.diameter, bb.diameter);
-}
-
 }  // namespace
 
 void screenStarts(std::vector<PoseCandidate>& candidates) {
@@ -210,20 +198,16 @@ void screenStarts(std::vector<PoseCandidate>& candidates) {
 
 std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
                                    float duplicate_fraction) {
+  // Without the first fit every start goes at once; with it, best first (ties keep the
+  // stage 6 order), the measured ones taking part as the better ones they may be.
   std::vector<std::size_t> order, round;
-  for (std::size_t i = 0; i < candidates.size(); ++i)
-    if (candidates[i].refinable() && !candidates[i].measured) {
-      if (candidates[i].refine.first_fit)
-        order.push_back(i);
-      else
-        round.push_back(i);  // every start at once, as before the first fit
-    }
-  if (order.empty()) return round;
-  // Places best first; ties keep the stage 6 order. Measured candidates take part as the
-  // better ones they may be.
-  order.clear();
-  for (std::size_t i = 0; i < candidates.size(); ++i)
-    if (candidates[i].refinable() && candidates[i].refine.first_fit) order.push_back(i);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const PoseCandidate& c = candidates[i];
+    if (c.refinable() && c.refine.first_fit)
+      order.push_back(i);
+    else if (c.refinable() && !c.measured)
+      round.push_back(i);
+  }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return poseScore(candidates[a].first_evidence) > poseScore(candidates[b].first_evidence);
   });
@@ -236,7 +220,9 @@ std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const
     const PoseCandidate* passed = nullptr;
     for (std::size_t j = 0; j < k && !passed; ++j) {
       const PoseCandidate& better = candidates[order[j]];
-      if (!better.screened.empty() || !onePlace(better, c, banks, duplicate_fraction)) continue;
+      if (!better.screened.empty() ||
+          !samePlace(better.first_fit.pose, better.bank(), c.first_fit.pose, c.bank(), banks, duplicate_fraction))
+        continue;
       if (better.bank() == c.bank())
         ++same_object;  // refined alongside: the first fit's ranking is not the final one
       else if (!better.measured)
