@@ -126,23 +126,31 @@ std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector
   return frames;
 }
 
-/// The detector's stage names as the report groups them: the match readback goes with
-/// similarity; the template upload is reported apart.
-const std::vector<std::pair<std::string, std::vector<std::string>>>& stageGroups() {
-  static const std::vector<std::pair<std::string, std::vector<std::string>>> groups = {
-      {"features", {"features"}},
-      {"similarity", {"depth_pruning", "similarity", "match_readback"}},
-      {"clustering", {"clustering"}},
-      {"scoring", {"scoring"}},
-      {"nms", {"nms"}},
-      {"initial_pose", {"initial_pose"}},
-      {"first_fit", {"first_fit"}},
-      {"mls", {"mls"}},
-      {"icp", {"icp"}},
-      {"verification", {"verification"}},
-      {"symmetries", {"symmetries"}},
-      {"edges", {"edges"}},              // colour only: the frame's edge maps
-      {"contour_fit", {"contour_fit"}},  // colour only: stage 7 on the image's edges
+/// Stages 6-8 (a sweep's pose time).
+bool isPoseStage(const std::string& name) {
+  for (const Stage stage : {Stage::initial_pose, Stage::first_fit, Stage::mls, Stage::icp, Stage::verification,
+                            Stage::symmetries})
+    if (name == stageName(stage)) return true;
+  return false;
+}
+
+/// The detector's stages as the report groups them (under the first's name): the match
+/// readback goes with similarity; the template upload is reported apart.
+const std::vector<std::vector<Stage>>& stageGroups() {
+  static const std::vector<std::vector<Stage>> groups = {
+      {Stage::features},
+      {Stage::similarity, Stage::depth_pruning, Stage::match_readback},
+      {Stage::clustering},
+      {Stage::scoring},
+      {Stage::nms},
+      {Stage::initial_pose},
+      {Stage::first_fit},
+      {Stage::mls},
+      {Stage::icp},
+      {Stage::verification},
+      {Stage::symmetries},
+      {Stage::edges},        // colour only: the frame's edge maps
+      {Stage::contour_fit},  // colour only: stage 7 on the image's edges
   };
   return groups;
 }
@@ -220,7 +228,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   for (int i = 0; i < o.warmup; ++i) {
     const DetectionResult r = detector.detect(frames[0].frame, frames[0].camera);
     for (const auto& [stage, ms] : r.timings_ms)
-      if (stage == "upload") report.upload_ms += ms;
+      if (stage == stageName(Stage::upload)) report.upload_ms += ms;
     report_progress("warm-up", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.warmup));
   }
   for (int i = 0; i < o.frames; ++i) {
@@ -230,19 +238,24 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
       for (const auto& w : r.warnings) report.warnings.push_back(w);
     std::map<std::string, double> by_name(r.timings_ms.begin(), r.timings_ms.end());
     const std::map<std::string, double> kernel_by_name(r.kernel_ms.begin(), r.kernel_ms.end());
-    const double upload = by_name.count("upload") ? by_name["upload"] : 0.0;
+    const double upload = by_name.count(stageName(Stage::upload)) ? by_name[stageName(Stage::upload)] : 0.0;
     report.upload_ms += upload;
-    for (const auto& [group, names] : stageGroups()) {
+    for (const auto& stages : stageGroups()) {
+      const std::string group = stageName(stages.front());
       double ms = 0;
       bool ran = false;
-      for (const auto& n : names) {
+      for (const Stage stage : stages) {
+        const std::string n = stageName(stage);
         if (by_name.count(n)) ms += by_name[n], ran = true;
         if (const auto k = kernel_by_name.find(n); k != kernel_by_name.end()) kernel_sum[group] += k->second;
       }
       if (ran) times[group].push_back(ms);
     }
-    totals.push_back(by_name["total"] - upload);
-    match_ms.push_back(by_name["depth_pruning"] + by_name["features"] + by_name["similarity"] + by_name["match_readback"]);
+    totals.push_back(by_name[stageName(Stage::total)] - upload);
+    double match = 0;
+    for (const Stage stage : {Stage::depth_pruning, Stage::features, Stage::similarity, Stage::match_readback})
+      match += by_name[stageName(stage)];
+    match_ms.push_back(match);
     pairs += r.match_pairs;
     pruned += r.match_pairs_pruned;
     skipped += r.match_pairs_skipped;
@@ -258,8 +271,9 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
     accepted += static_cast<double>(r.detections.size());
     report_progress("detect", static_cast<std::size_t>(i + 1), static_cast<std::size_t>(o.frames));
   }
-  for (const auto& [group, names] : stageGroups())
-    if (const auto it = times.find(group); it != times.end()) {
+  for (const auto& stages : stageGroups())
+    if (const auto it = times.find(stageName(stages.front())); it != times.end()) {
+      const std::string group = it->first;
       double sum = 0;
       for (const double t : it->second) sum += t;
       const double mean = sum / o.frames, kernel = kernel_sum[group] / o.frames;
@@ -276,7 +290,7 @@ DetectBenchReport runDetectBenchmark(const DetectBenchOptions& o, const GpuOptio
   for (const double t : totals) total_sum += t;
   double kernel_total = 0;
   for (const auto& [group, ms] : kernel_sum) kernel_total += ms / o.frames;
-  report.stages.push_back({"total", median(totals), percentile(totals, 95), total_sum / o.frames, kernel_total,
+  report.stages.push_back({stageName(Stage::total), median(totals), percentile(totals, 95), total_sum / o.frames, kernel_total,
                            total_sum / o.frames - kernel_total});
   report.frames_per_s = total_sum > 0 ? 1000.0 * o.frames / total_sum : 0.0;
   if (o.in_flight && o.frames > 1) {
@@ -438,9 +452,8 @@ std::vector<DetectSweepRow> runDetectSweep(const DetectBenchOptions& options, De
     row.instances = o.instances;
     row.templates = r.templates;
     for (const auto& st : r.stages) {
-      if (st.stage == "total") row.total_ms = st.median_ms;
-      else if (st.stage == "initial_pose" || st.stage == "first_fit" || st.stage == "mls" || st.stage == "icp" || st.stage == "verification" ||
-               st.stage == "symmetries")
+      if (st.stage == stageName(Stage::total)) row.total_ms = st.median_ms;
+      else if (isPoseStage(st.stage))
         row.pose_ms += st.median_ms;
       else row.match_ms += st.median_ms;
     }

@@ -124,6 +124,11 @@ expect "detect: a sequence without --out-dir or --jsonl" 1 "$vkpose" detect --ba
 expect "detect: neither a frame nor a sequence" 2 "$vkpose" detect --bank "$dir/cube.vkpb" --camera "$dir/camera.json"
 expect "detect: a frame and a sequence" 2 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --frames "$dir/seq"
 expect "detect: wrong flag" 2 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --no-such-flag
+# A stage flag's range is the parameter table's, the same as the config file's.
+expect "detect: a flag outside its range" 2 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --threshold 0
+printf '{"match": {"threshold": 0}}' >"$dir/zero_threshold.json"
+expect "detect: a config value outside its range" 1 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" \
+  --config "$dir/zero_threshold.json"
 expect "detect: an unknown sensor" 1 "$vkpose" detect --bank "$dir/cube.vkpb" "${frame[@]}" --sensor kinnect
 expect "detect: a sensor profile" 0 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" --no-pose --sensor ideal
 expect "detect: no Vulkan driver" 3 env VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json \

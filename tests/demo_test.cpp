@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
+#include <set>
+#include <variant>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -245,6 +248,52 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
   };
   EXPECT_NE(message("kinnect").find("kinect, primesense, realsense-d435, ideal"), std::string::npos);
   EXPECT_NE(message(bad).find("unknown key \"sigma\""), std::string::npos);
+}
+
+// The one parameter table: each number has one range, its default lies in it, and a value
+// just outside it is refused by the detector's checks with the parameter's name (the config
+// file, the flags and Python all go through the same checks).
+TEST(Config, EveryParameterHasOneRangeThatTheChecksUse) {
+  DetectorParams defaults;
+  std::set<std::string> flags;
+  int refused = 0;
+  for (const ConfigField& f : configFields(defaults)) {
+    const std::string name = f.section + "." + f.key;
+    if (!f.flag.empty()) {
+      EXPECT_TRUE(flags.insert(f.flag).second) << "two parameters share the flag " << f.flag;
+    }
+    std::visit(
+        [&](auto* field) {
+          using T = std::remove_pointer_t<decltype(field)>;
+          if constexpr (!std::is_same_v<T, bool>) {
+            EXPECT_TRUE(f.range.contains(static_cast<double>(*field))) << name << " default outside " << f.range.text();
+            std::vector<double> outside;
+            if (f.range.min > -1e300) outside.push_back(f.range.min_open ? f.range.min : f.range.min - 1);
+            if (f.range.max < 1e300) outside.push_back(f.range.max_open ? f.range.max : f.range.max + 1);
+            for (const double v : outside) {
+              if (v < static_cast<double>(std::numeric_limits<T>::lowest())) continue;  // unsigned below 0
+              DetectorParams p;
+              std::vector<ConfigField> fields = configFields(p);
+              const auto it = std::find_if(fields.begin(), fields.end(), [&](const ConfigField& g) {
+                return g.section == f.section && g.key == f.key;
+              });
+              *std::get<T*>(it->value) = static_cast<T>(v);
+              try {
+                validateDetectorParams(p);
+                ADD_FAILURE() << name << " = " << v << " passed the checks; its range is " << f.range.text();
+              } catch (const InputError& e) {
+                EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+                ++refused;
+              }
+            }
+          }
+        },
+        f.value);
+  }
+  EXPECT_GT(refused, 80) << "most parameters have a bound";
+  EXPECT_TRUE(flags.count("--threshold") && flags.count("!--no-pose") && flags.count("--min-collision"));
+  // The explanation shows the ranges.
+  EXPECT_NE(configTable().find("(0, 100]"), std::string::npos);
 }
 
 TEST(Config, BadFilesAreClearErrors) {

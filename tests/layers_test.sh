@@ -10,14 +10,16 @@ root="$1"
 # floor of each folder of src/, lowest first
 declare -A floor=(
   [util]=0
-  [gpu]=1 [geometry]=1
+  [gpu]=1 [geometry]=1 [config]=1
   [match]=2 [render]=2
   [training]=3
   [hypotheses]=4
   [pose]=5
   [pipeline]=6
-  [io]=7 [eval]=7 [synth]=7 [pick]=7
-  [cli]=8 [python]=8 [bench]=8
+  [io]=7
+  [eval]=8 [pick]=8
+  [synth]=9
+  [cli]=10 [python]=10 [bench]=10
 )
 status=0
 checked=0
@@ -42,6 +44,29 @@ for dir in "$root"/src/*/; do
     fi
   done < <(grep -Hn '#include "[a-z_]*/' "$dir"*.?pp 2>/dev/null || true)
 done
-echo "src/: $checked includes between folders checked"
+# The CMake targets: each layer's vkpose_layer(...) in CMakeLists.txt may link only layers of
+# its floor and below.
+links=0
+while IFS= read -r entry; do
+  layer=${entry%%:*}
+  for dep in ${entry#*:}; do
+    target=${dep#vkpose_}
+    [ "$target" = "$dep" ] && continue   # a library from outside (Vulkan::Vulkan, ...)
+    [ "$target" = shaders ] && continue  # the embedded SPIR-V, below every layer
+    links=$((links + 1))
+    if [ -z "${floor[$target]+x}" ] || [ -z "${floor[$layer]+x}" ]; then
+      echo "CMakeLists.txt: vkpose_$layer links vkpose_$target, a layer with no floor"
+      status=1
+    elif [ "${floor[$target]}" -gt "${floor[$layer]}" ]; then
+      echo "CMakeLists.txt: vkpose_$layer (floor ${floor[$layer]}) links vkpose_$target (floor ${floor[$target]})"
+      status=1
+    fi
+  done
+done < <(awk '/^vkpose_layer\(/ { name = substr($1, 14); inl = 1; next }
+              inl && /^ *(LINK|PRIVATE_LINK) / { line = $0; sub(/^ *(PRIVATE_)?LINK /, "", line); sub(/\)$/, "", line);
+                                                 print name ":" line }
+              inl && /\)$/ { inl = 0 }' "$root/CMakeLists.txt")
+[ "$links" -gt 0 ] || { echo "CMakeLists.txt: no vkpose_layer() links found"; status=1; }
+echo "src/: $checked includes between folders checked, $links links between layer targets"
 [ $status -eq 0 ] && echo "layers: ok"
 exit $status

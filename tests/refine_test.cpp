@@ -340,7 +340,9 @@ TEST(Refine, RejectsNonsenseParameters) {
   EXPECT_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.fine_fraction = 1.5f; })), InputError);
   EXPECT_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.mls_radius = 0.f; })), InputError);
   EXPECT_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.fine_iterations = -1; })), InputError);
-  EXPECT_NO_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.mls = false, p.mls_radius = 0.f; })));
+  // One range per parameter (the config table's): a radius of 0 is refused with MLS off too.
+  EXPECT_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.mls = false, p.mls_radius = 0.f; })), InputError);
+  EXPECT_NO_THROW(refinePose(cloud, cloud, {}, with([](auto& p) { p.mls = false; })));
   EXPECT_THROW(smoothMls(cloud, std::nanf(""), 2), InputError);
 }
 

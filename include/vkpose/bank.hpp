@@ -3,6 +3,7 @@
 // rendered from a mesh with their LINEMOD features, the pose each was rendered at and the
 // depth/normal crops the cluster score compares; the bank file that stores them, and a cache
 // of banks kept between runs.
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -22,7 +23,15 @@ namespace vkpose {
 /// An evenly stepped range, both ends included: from, from + step, ..., to.
 struct SteppedRange {
   float from = 0.f, to = 0.f, step = 1.f;
-  std::vector<float> values() const;
+  /// Index-based so that rounding never drops the last value or adds one past `to`. Inline:
+  /// the matcher's depth gate (below training) reads the trained distances too.
+  std::vector<float> values() const {
+    if (step <= 0.f) return {from};
+    std::vector<float> out;
+    const int n = static_cast<int>(std::floor((to - from) / step + 1e-4f)) + 1;
+    for (int i = 0; i < n; ++i) out.push_back(from + static_cast<float>(i) * step);
+    return out;
+  }
 };
 
 /// Parses "A:B:STEP" (or a single value "A"); throws InputError on nonsense.

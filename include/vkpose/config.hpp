@@ -438,12 +438,39 @@ std::string scaledLengthsReport(const DetectorParams& params, float diameter_m, 
 
 // ---- the config file ------------------------------------------------------------------
 
+/// The values a number parameter accepts: from `min` to `max`, either end open or unbounded.
+/// One range per parameter: the config file, the command-line flag, Python's Config and the
+/// stage's own check all test this one.
+struct ValueRange {
+  double min = -1e300, max = 1e300;  ///< +-1e300: unbounded (every finite value)
+  bool min_open = false, max_open = false;
+  bool contains(double v) const;
+  std::string text() const;  ///< "[0, 1]", "(0, 100]", ">= 1", "> 0", "any"
+};
+/// [lo, hi]
+inline ValueRange closed(double lo, double hi) { return {lo, hi, false, false}; }
+/// (lo, hi]
+inline ValueRange aboveUpTo(double lo, double hi) { return {lo, hi, true, false}; }
+/// [lo, hi)
+inline ValueRange fromBelow(double lo, double hi) { return {lo, hi, false, true}; }
+/// [lo, infinity)
+inline ValueRange atLeast(double lo) { return {lo, 1e300, false, false}; }
+/// (lo, infinity)
+inline ValueRange above(double lo) { return {lo, 1e300, true, false}; }
+
 /// One parameter: where it lives in the file ("section": {"key": value}), what it means (with
-/// its unit), and the field it sets.
+/// its unit), the field it sets, the values it accepts and, where it has one, the `detect`
+/// command-line flag that sets it too ("!--no-pose": a flag that sets a bool false).
 struct ConfigField {
   std::string section, key, doc;
   std::variant<float*, double*, int*, unsigned*, std::size_t*, bool*> value;
+  ValueRange range = {};
+  std::string flag = {};
 };
+
+/// InputError naming `section.key`, its value and its range when a field of `params` (of
+/// `section` only, when one is given) lies outside its range or is not finite.
+void checkRanges(const DetectorParams& params, const std::string& section = {});
 
 /// Every stage parameter of `params`, in pipeline order; the pointers refer into `params`.
 std::vector<ConfigField> configFields(DetectorParams& params);

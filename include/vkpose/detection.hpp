@@ -84,8 +84,27 @@ struct Detection {
   float look_alike_margin = 0.f;
 };
 
-/// Milliseconds per stage, in pipeline order.
+/// The stages a DetectionResult times, in pipeline order. Colour-only frames time `edges` and
+/// `contour_fit` in place of `first_fit`, `mls` and `icp`; the linemod baseline times `poses`.
+enum class Stage {
+  upload, depth_pruning, features, similarity, match_readback,  // stages 1-2
+  clustering, scoring, nms,                                      // stages 3-5
+  initial_pose, first_fit, mls, icp, verification, symmetries,   // stages 6-8
+  edges, contour_fit, poses, total
+};
+/// What the detection JSON, Python and the benchmarks call a stage.
+constexpr const char* stageName(Stage stage) {
+  constexpr const char* kNames[] = {"upload",       "depth_pruning", "features", "similarity",   "match_readback",
+                                    "clustering",   "scoring",       "nms",      "initial_pose", "first_fit",
+                                    "mls",          "icp",           "verification", "symmetries", "edges",
+                                    "contour_fit",  "poses",         "total"};
+  return kNames[static_cast<int>(stage)];
+}
+
+/// Milliseconds per stage, in pipeline order, under stageName().
 using StageTimings = std::vector<std::pair<std::string, double>>;
+/// Adds a stage's milliseconds under its name.
+inline void addStage(StageTimings& timings, Stage stage, double ms) { timings.emplace_back(stageName(stage), ms); }
 
 struct DetectionResult {
   std::vector<Detection> detections;  ///< best score first

@@ -62,13 +62,9 @@ Runner addBenchDetectCommand(CLI::App& bench, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--data", options->data_dir, "Folder of the real frames (default: ../shared/data)");
   sub->add_option("--seed", options->seed, "Seed of the synthetic frames")->capture_default_str();
-  sub->add_option("--threshold", options->params.match.threshold, "Match threshold, percent (both vkpose and cv::linemod)")
-      ->check(CLI::Range(1.0, 100.0))
-      ->capture_default_str();
-  sub->add_flag("!--no-pose", options->params.estimate_poses, "Stop after NMS (stages 1-5 only)");
-  sub->add_option("--threads", options->params.threads,
-                  "CPU threads for the pose stages (0: every core); results are the same for any count")
-      ->capture_default_str();
+  addParamFlag(sub, options->params, "--threshold", ", vkpose and cv::linemod");
+  addParamFlag(sub, options->params, "--no-pose");
+  addParamFlag(sub, options->params, "--threads");
   sub->add_flag("!--no-opencv", options->run_opencv, "Skip the cv::linemod baseline");
   sub->add_flag("--no-depth", options->no_depth,
                 "Drop the frames' depth images: colour-only detection, stage times of that path (cv::linemod on "

@@ -58,7 +58,7 @@ nlohmann::json printMatchRows(const std::vector<bench::MatchBenchRow>& rows) {
   for (const auto& r : rows) {
     std::string cells;
     for (const auto& st : r.stages)
-      cells += st.name == "match_readback"
+      cells += st.name == stageName(Stage::match_readback)
                    ? fmt::format("  {:>14.1f}", st.ms)
                    : fmt::format("  {:>26}", fmt::format("{:.1f} ({:.1f}/{:.1f})", st.ms, st.kernel_ms, st.ms - st.kernel_ms));
     fmt::print("{:>9}{}\n", r.templates, cells);

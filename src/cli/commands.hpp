@@ -38,6 +38,12 @@ Runner addConfigCommand(CLI::App& app, const GlobalOptions& global);
 void addConfigOption(CLI::App* sub, std::string& path);
 /// `--sensor NAME|FILE` (config.hpp's sensorProfile()); `what` says what the sensor sets.
 void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what);
+/// The command-line flag of a stage parameter (`flag` as the parameter table in config_io.cpp
+/// names it, "--no-pose" for "!--no-pose"): its meaning (and `note`), range and default from
+/// the table, bound to the field of `params`.
+CLI::Option* addParamFlag(CLI::App* sub, DetectorParams& params, const std::string& flag, const std::string& note = {});
+/// Every stage parameter with a flag in the table, in pipeline order, in `group` of the help.
+void addStageFlags(CLI::App* sub, DetectorParams& params, const std::string& group);
 /// The stage parameters of a command: the config file's (when `path` is not empty), overridden
 /// by the flags that differ from the defaults.
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags);

@@ -1,5 +1,11 @@
 // `vkpose config --print-defaults | --explain`, and the `--config FILE` option of the commands
 // that detect (detect, eval, demo, bench).
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
@@ -20,6 +26,44 @@ void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what
                   fmt::format("Depth sensor: {} (default {}), or a JSON file {{\"axial_sigma_at_1m\": m, "
                               "\"quantization_m\": m}}; {}",
                               names, sensorProfileNames().front(), what));
+}
+
+CLI::Option* addParamFlag(CLI::App* sub, DetectorParams& params, const std::string& flag, const std::string& note) {
+  const std::vector<ConfigField> fields = configFields(params);
+  const auto f = std::find_if(fields.begin(), fields.end(),
+                              [&](const ConfigField& c) { return c.flag == flag || c.flag == "!" + flag; });
+  if (f == fields.end()) throw std::logic_error("no stage parameter has the flag " + flag);
+  std::string help = f->doc + note + fmt::format(" ({}.{})", f->section, f->key);
+  help[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(help[0])));
+  return std::visit(
+      [&](auto* field) -> CLI::Option* {
+        if constexpr (std::is_same_v<std::remove_pointer_t<decltype(field)>, bool>) {
+          if (f->flag[0] != '!') return sub->add_flag(f->flag, *field, help);
+          return sub->add_flag(f->flag, *field,
+                               fmt::format("Sets {}.{} false; it means: {}{}", f->section, f->key, f->doc, note));
+        } else {
+          const ValueRange range = f->range;
+          const CLI::Validator in_range(
+              [range](std::string& text) -> std::string {
+                double v = 0.0;
+                try {
+                  v = std::stod(text);
+                } catch (const std::exception&) {
+                  return "not a number: " + text;
+                }
+                return range.contains(v) ? std::string() : fmt::format("{} is not {}", text, range.text());
+              },
+              range.text());
+          return sub->add_option(f->flag, *field, help)->check(in_range)->capture_default_str();
+        }
+      },
+      f->value);
+}
+
+void addStageFlags(CLI::App* sub, DetectorParams& params, const std::string& group) {
+  DetectorParams defaults;
+  for (const ConfigField& f : configFields(defaults))
+    if (!f.flag.empty()) addParamFlag(sub, params, f.flag[0] == '!' ? f.flag.substr(1) : f.flag)->group(group);
 }
 
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags) {

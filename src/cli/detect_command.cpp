@@ -352,72 +352,6 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
 }
 
 /// The stage parameters `detect` takes as flags (a --config file sets every one).
-void addStageFlags(CLI::App* sub, DetectorParams& p) {
-  auto* stages = "Stage parameters";
-  sub->add_option("--threshold", p.match.threshold, "LINEMOD similarity a match needs, percent")
-      ->check(CLI::Range(1.0, 100.0))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--cluster-step", p.cluster.position_step_px, "Clustering cell s_im, pixels")
-      ->check(CLI::Range(1, 512))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--min-templates", p.cluster.min_templates, "Smallest cluster tau_c, templates")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--threads", p.threads,
-                  "CPU threads for the pose stages (0: every core); results are the same for any count")
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--pose-candidates", p.pose_candidates_per_object,
-                  "Hypotheses per object that get a pose and verification (the best after NMS)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--pose-min-score", p.pose_min_score, "Smallest cluster score gamma a hypothesis needs for a pose, 0..1")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--min-score", p.min_score, "With --no-pose: smallest cluster score gamma a detection needs, 0..1")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--depth-unit", p.score.depth_unit_m, "Cluster score: alpha = exp(-depth error / unit), metres")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--angle-unit", p.score.angle_unit_rad, "Cluster score: beta = exp(-normal angle / unit), radians")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--nms-radius", p.nms.radius_px,
-                  "NMS radius r, pixels (0: half the projected object diameter)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_flag("!--no-pose", p.estimate_poses,
-                "Stop after NMS: report the best template's pose, without refinement or verification")
-      ->group(stages);
-  sub->add_option("--rotation-cluster", p.initial_pose.rotation_cluster_deg,
-                  "Initial pose: template rotations closer than this vote together (tau_theta), degrees")
-      ->check(CLI::Range(0.1, 180.0))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--icp-voxel", p.refine.voxel_size, "Refinement: voxel grid of scene and model, metres (0: none)")
-      ->check(CLI::Range(0.0, 0.1))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--octree-resolution", p.verify.resolution, "Verification: octree leaf size, metres")
-      ->check(CLI::Range(0.0005, 0.1))
-      ->capture_default_str()
-      ->group(stages);
-  sub->add_option("--min-collision", p.verify.threshold,
-                  "Verification: a pose is accepted when its collision rate phi exceeds this, 0..1")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str()
-      ->group(stages);
-}
 }  // namespace
 
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
@@ -466,7 +400,7 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--force", opt->force, "Overwrite output files that exist");
   addConfigOption(sub, opt->config);
   addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
-  addStageFlags(sub, p);
+  addStageFlags(sub, p, "Stage parameters");
   auto* picking = "Bin picking (docs/picking.md)";
   auto* grasps = sub->add_option("--grasps", opt->grasps,
                                  "Grasp file (JSON) of an object: its grasps are placed at each detection of it, "

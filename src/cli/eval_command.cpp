@@ -244,11 +244,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
-  sub->add_option("--threads", p.detector.threads,
-                  "CPU threads for the pose stages (0: every core; with --workers: the cores shared out among the "
-                  "workers)")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
+  addParamFlag(sub, p.detector, "--threads", "; with --workers, the cores shared out among the workers");
   auto* spread = "Spread over Dask's workers (python3-distributed; docs/evaluation.md)";
   auto* workers = sub->add_option("--workers", opt->dask.workers,
                                   "Run the images on N worker processes of a Dask cluster on this machine")
@@ -309,11 +305,7 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->group(protocol);
   auto* methods = "Method parameters";
-  sub->add_option("--threshold", p.detector.match.threshold,
-                  "LINEMOD similarity a match needs, percent (vkpose and linemod)")
-      ->check(CLI::Range(1.0, 100.0))
-      ->capture_default_str()
-      ->group(methods);
+  addParamFlag(sub, p.detector, "--threshold", ", vkpose and linemod")->group(methods);
   sub->add_option("--linemod-max-per-object", p.linemod.max_per_object,
                   "linemod: detections kept per object and image, the best by similarity (0: every raw match)")
       ->check(CLI::Range(0, 100000000))

@@ -170,7 +170,7 @@ std::vector<PoseEstimate> estimatesOf(Evaluator::State& s, MethodRun& run, const
   // The first frame uploads the templates: set-up, like training, not per-image work.
   image_ms = msSince(t0);
   for (const auto& [stage, ms] : r.timings_ms)
-    if (stage == "upload") image_ms -= ms;
+    if (stage == stageName(Stage::upload)) image_ms -= ms;
   warnings.insert(r.warnings.begin(), r.warnings.end());
   if (run.method == EvalMethod::Vkpose && s.params.on_detections) s.params.on_detections(im, frame, r);
   for (const auto& d : r.detections)

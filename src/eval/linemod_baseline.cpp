@@ -86,8 +86,8 @@ DetectionResult LinemodBaseline::detect(const LinemodFrame& frame, const Camera&
     result.detections.push_back(std::move(d));
   }
   result.hypotheses = result.scored_hypotheses = result.detections.size();
-  result.timings_ms.emplace_back("poses", util::msSince(t0));
-  result.timings_ms.emplace_back("total", util::msSince(total0));
+  addStage(result.timings_ms, Stage::poses, util::msSince(t0));
+  addStage(result.timings_ms, Stage::total, util::msSince(total0));
   return result;
 }
 

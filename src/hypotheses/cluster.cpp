@@ -8,6 +8,7 @@
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/config.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/geometry.hpp"
 
@@ -204,5 +205,32 @@ std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std:
     if (i >= 0) out.push_back(all[static_cast<std::size_t>(i)]);
   return out;
 }
+
+/// Stage 5. With poses: NMS within each object, then the best few of each object (see
+/// pose_min_score), objects competing after verification, in 3D; and a runner-up rides with
+/// each survivor that gets a pose. Without: one hypothesis a place for all (no verification
+/// removes a small part's duplicates).
+std::vector<Hypothesis> nonMaximumSuppression(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
+                                              float fx, const DetectorParams& params) {
+  NmsParams nms = params.nms;
+  if (!params.estimate_poses) {
+    nms.small_part_radius_fraction = nms.radius_fraction;
+    return suppressNonMaxima(std::move(hypotheses), banks, fx, nms);
+  }
+  nms.across_objects = false;
+  std::vector<Hypothesis> all;  // for the runners-up
+  if (nms.runner_up_share > 0.f) all = hypotheses;
+  hypotheses = suppressNonMaxima(std::move(hypotheses), banks, fx, nms);
+  std::vector<int> taken(banks.size(), 0);
+  std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
+    const auto b = static_cast<std::size_t>(h.bank);
+    const int most = isSmallPart(banks[b].diameter) ? params.small_part_pose_candidates
+                                                    : params.pose_candidates_per_object;
+    return taken[b]++ >= most;
+  });
+  for (auto& h : runnersUp(all, hypotheses, banks, fx, nms)) hypotheses.push_back(std::move(h));
+  return hypotheses;
+}
+
 
 }  // namespace vkpose

@@ -98,4 +98,10 @@ Eigen::Matrix3f viewingRayRotation(float x, float y, const Camera& camera);
 std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std::vector<Hypothesis>& kept,
                                   const std::vector<TemplateBank>& banks, double fx, const NmsParams& params);
 
+/// Stage 5 as the detector runs it (DetectorParams): with poses, NMS within each object, the
+/// best pose_candidates_per_object (small_part_pose_candidates) of each, and their runners-up;
+/// without, one hypothesis a place for all objects.
+std::vector<Hypothesis> nonMaximumSuppression(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
+                                              float fx, const DetectorParams& params);
+
 }  // namespace vkpose

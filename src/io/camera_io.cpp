@@ -9,16 +9,6 @@
 
 namespace vkpose {
 
-void validateCamera(const Camera& c, const std::string& source) {
-  auto bad = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", source, what)); };
-  if (!(std::isfinite(c.fx) && std::isfinite(c.fy) && c.fx > 0 && c.fy > 0))
-    bad(fmt::format("focal lengths must be positive (fx {}, fy {})", c.fx, c.fy));
-  if (!(std::isfinite(c.cx) && std::isfinite(c.cy))) bad("the principal point is not finite");
-  if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
-    bad(fmt::format("image size {}x{} is outside 1..16384", c.width, c.height));
-  if (!(std::isfinite(c.depth_scale) && c.depth_scale > 0)) bad(fmt::format("depth_scale {} must be positive", c.depth_scale));
-}
-
 namespace {
 double number(const nlohmann::json& j, const char* key, const std::string& path) {
   if (!j.contains(key) || !j[key].is_number()) throw InputError(fmt::format("{}: missing or non-numeric '{}'", path, key));

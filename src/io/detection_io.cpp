@@ -7,11 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "hypotheses/cluster_score.hpp"
-#include "hypotheses/hypotheses.hpp"
 #include "io/image_file.hpp"
-#include "match/matcher.hpp"
-#include "render/render.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/device.hpp"

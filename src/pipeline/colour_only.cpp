@@ -262,10 +262,10 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   StageClock clock(ctx_);
   std::vector<Hypothesis> hypotheses = clusterTemplates(matches, banks_, params_.cluster);
   result.hypotheses = hypotheses.size();
-  clock.end("clustering", result);
+  clock.end(Stage::clustering, result);
   scoreBySimilarity(hypotheses);
   result.scored_hypotheses = hypotheses.size();
-  clock.end("scoring", result);
+  clock.end(Stage::scoring, result);
 
   NmsParams nms = params_.nms;
   nms.across_objects = !params_.estimate_poses;
@@ -275,10 +275,10 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   std::erase_if(hypotheses, [&](const Hypothesis& h) {
     return taken[static_cast<std::size_t>(h.bank)]++ >= params_.colour_only.candidates_per_object;
   });
-  clock.end("nms", result);
+  clock.end(Stage::nms, result);
   if (!params_.estimate_poses) {
     result.detections = templateDetections(hypotheses, banks_, camera);
-    result.timings_ms.emplace_back("total", msSince(total0));
+    addStage(result.timings_ms, Stage::total, msSince(total0));
     return result;
   }
 
@@ -296,19 +296,19 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
       hypothesis_of.push_back(k);
     }
   attachRenderers();
-  clock.end("initial_pose", result);
+  clock.end(Stage::initial_pose, result);
   const EdgeDistanceMaps maps = edgeDistanceMaps(frame.bgr, params_.colour_only.canny_low, params_.colour_only.canny_high);
-  clock.end("edges", result);
+  clock.end(Stage::edges, result);
   fitAndVerifyByContour(candidates, objects_, camera, frame.bgr, maps, params_);
   for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
-  clock.end("contour_fit", result);
+  clock.end(Stage::contour_fit, result);
   keepBestStart(candidates, hypothesis_of, result);
   acceptByContour(candidates, banks_, camera, result);
-  clock.end("verification", result);
+  clock.end(Stage::verification, result);
   result.pose_wall_ms = msSince(wall0);
   result.pose_cpu_ms = util::processCpuMs() - cpu0;
   result.pose_threads = util::threadsFor(candidates.size(), params_.threads);
-  result.timings_ms.emplace_back("total", msSince(total0));
+  addStage(result.timings_ms, Stage::total, msSince(total0));
   return result;
 }
 

@@ -36,58 +36,6 @@ bool sameFeatures(const FeatureParams& a, const FeatureParams& b) {
   return a.T == b.T && a.use_colour == b.use_colour && a.use_depth == b.use_depth;
 }
 
-/// What stages 6-8 know of each bank's object, but its renderer (Detector::attachRenderers).
-std::vector<PoseObject> poseObjects(const std::vector<TemplateBank>& banks, const DetectorParams& params) {
-  std::vector<PoseObject> objects(banks.size());
-  for (std::size_t b = 0; b < banks.size(); ++b) {
-    objects[b].bank = &banks[b];
-    for (const auto& v : banks[b].mesh.vertices)
-      objects[b].bounding_radius = std::max(objects[b].bounding_radius, (v - banks[b].centre).norm());
-    objects[b].colourful = meshChromaSpread(banks[b].mesh) >= kMinChromaSpread;
-  }
-  // Look-alike half-turns: about 0.1 s a mesh, so found here rather than stored (banks of
-  // every version get them, and the tolerance stays a detection setting).
-  if (params.verify.resolve_symmetries)
-    util::parallelFor(
-        banks.size(),
-        [&](std::size_t b) {
-          const TemplateBank& bank = banks[b];
-          if (bank.symmetric) return;  // scored with ADI: turns do not count against it
-          const float from = std::max(bank.params.near_symmetry_tolerance, 0.01f) * bank.diameter;
-          const float share = isSmallPart(bank.diameter) ? params.verify.small_part_look_alike_tolerance
-                                                         : params.verify.look_alike_tolerance;
-          objects[b].look_alike_turns = findLookAlikeTurns(bank.mesh, from, share * bank.diameter);
-        },
-        params.threads);
-  return objects;
-}
-
-/// Stage 5. With poses: NMS within each object, then the best few of each object (see
-/// pose_min_score), objects competing after verification, in 3D; and a runner-up rides with
-/// each survivor that gets a pose. Without: one hypothesis a place for all (no verification
-/// removes a small part's duplicates).
-std::vector<Hypothesis> nonMaximumSuppression(std::vector<Hypothesis> hypotheses, const std::vector<TemplateBank>& banks,
-                                              float fx, const DetectorParams& params) {
-  NmsParams nms = params.nms;
-  if (!params.estimate_poses) {
-    nms.small_part_radius_fraction = nms.radius_fraction;
-    return suppressNonMaxima(std::move(hypotheses), banks, fx, nms);
-  }
-  nms.across_objects = false;
-  std::vector<Hypothesis> all;  // for the runners-up
-  if (nms.runner_up_share > 0.f) all = hypotheses;
-  hypotheses = suppressNonMaxima(std::move(hypotheses), banks, fx, nms);
-  std::vector<int> taken(banks.size(), 0);
-  std::erase_if(hypotheses, [&](const Hypothesis& h) {  // best first
-    const auto b = static_cast<std::size_t>(h.bank);
-    const int most = isSmallPart(banks[b].diameter) ? params.small_part_pose_candidates
-                                                    : params.pose_candidates_per_object;
-    return taken[b]++ >= most;
-  });
-  for (auto& h : runnersUp(all, hypotheses, banks, fx, nms)) hypotheses.push_back(std::move(h));
-  return hypotheses;
-}
-
 }  // namespace
 
 Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorParams params)
@@ -109,13 +57,13 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
 Detector::~Detector() = default;
 
 void appendMatchTimings(const MatchTimings& t, DetectionResult& r) {
-  if (t.upload_ms > 0) r.timings_ms.emplace_back("upload", t.upload_ms);
-  if (t.pairs > 0) r.timings_ms.emplace_back("depth_pruning", t.pruning_ms);
-  r.timings_ms.emplace_back("features", t.features_ms);
-  r.timings_ms.emplace_back("similarity", t.similarity_ms);
-  r.timings_ms.emplace_back("match_readback", t.finish_ms);
-  r.kernel_ms.emplace_back("features", t.features_kernel_ms);
-  r.kernel_ms.emplace_back("similarity", t.similarity_kernel_ms);
+  if (t.upload_ms > 0) addStage(r.timings_ms, Stage::upload, t.upload_ms);
+  if (t.pairs > 0) addStage(r.timings_ms, Stage::depth_pruning, t.pruning_ms);
+  addStage(r.timings_ms, Stage::features, t.features_ms);
+  addStage(r.timings_ms, Stage::similarity, t.similarity_ms);
+  addStage(r.timings_ms, Stage::match_readback, t.finish_ms);
+  addStage(r.kernel_ms, Stage::features, t.features_kernel_ms);
+  addStage(r.kernel_ms, Stage::similarity, t.similarity_kernel_ms);
 }
 
 /// A warning for each bank trained for another focal length than the camera's (by over 10 %).
@@ -211,17 +159,17 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   StageClock clock(ctx_);
   std::vector<Hypothesis> hypotheses = clusterTemplates(matches, banks_, params_.cluster);
   result.hypotheses = hypotheses.size();
-  clock.end("clustering", result);
+  clock.end(Stage::clustering, result);
 
   const ScoreScene scene = makeScoreScene(frame.depth_mm, camera);
   scorer_->score(hypotheses, banks_, scene, params_.score);
   const float min_score = params_.estimate_poses ? params_.pose_min_score : params_.min_score;
   std::erase_if(hypotheses, [&](const Hypothesis& h) { return h.best_member < 0 || h.score < min_score; });
   result.scored_hypotheses = hypotheses.size();
-  clock.end("scoring", result);
+  clock.end(Stage::scoring, result);
 
   hypotheses = nonMaximumSuppression(std::move(hypotheses), banks_, camera.fx, params_);
-  clock.end("nms", result);
+  clock.end(Stage::nms, result);
 
   // Frames in flight: the GPU is done with this frame (matching, cluster scores), so the next
   // frame's stages 1-2 start there now and run while this frame's CPU stages do. A next frame
@@ -239,7 +187,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   } else {
     result.detections = templateDetections(hypotheses, banks_, camera);
   }
-  result.timings_ms.emplace_back("total", msSince(total0));
+  addStage(result.timings_ms, Stage::total, msSince(total0));
   return result;
 }
 
@@ -254,7 +202,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   std::vector<PoseCandidate> candidates = startCandidates(clusters, banks_, frame.camera, params_);
   attachRenderers();
   initialPoses(candidates, objects_, frame, params_);
-  clock.end("initial_pose", result);
+  clock.end(Stage::initial_pose, result);
   // Stage 7: a cheap first fit of every start stops those that cannot pass stage 8; then MLS
   // smoothing of each crop and ICP (timed apart: they cost about the same), and stage 8's
   // measurements, in rounds: a start in the place of another object's better start waits
@@ -262,7 +210,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   if (params_.refine.first_fit) {
     firstFits(candidates, frame, threads);
     screenStarts(candidates);
-    clock.end("first_fit", result);
+    clock.end(Stage::first_fit, result);
   }
   std::pair<double, double> mls_ms, icp_ms, measure_ms;
   const auto add = [](std::pair<double, double>& sum, std::pair<double, double> ms) {
@@ -278,9 +226,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
     verifyCandidates(candidates, round, frame, threads);
     add(measure_ms, clock.split());
   }
-  for (const auto& [stage, ms] : {std::pair{"mls", mls_ms}, std::pair{"icp", icp_ms}}) {
-    result.timings_ms.emplace_back(stage, ms.first);
-    result.kernel_ms.emplace_back(stage, ms.second);
+  for (const auto& [stage, ms] : {std::pair{Stage::mls, mls_ms}, std::pair{Stage::icp, icp_ms}}) {
+    addStage(result.timings_ms, stage, ms.first);
+    addStage(result.kernel_ms, stage, ms.second);
   }
   // Stage 8: the collision rate and the depth and outline tests (measured above); the poses
   // that pass are rendered against their near-symmetric turns and look-alikes (twins of
@@ -298,9 +246,9 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   }
   acceptPoses(candidates, banks_, frame.camera, params_, result);
   // Verification: its measurements in the rounds, plus this, less the symmetries timed apart.
-  clock.end("verification", result, {symmetries_ms.first - measure_ms.first, symmetries_ms.second - measure_ms.second});
-  result.timings_ms.emplace_back("symmetries", symmetries_ms.first);
-  result.kernel_ms.emplace_back("symmetries", symmetries_ms.second);
+  clock.end(Stage::verification, result, {symmetries_ms.first - measure_ms.first, symmetries_ms.second - measure_ms.second});
+  addStage(result.timings_ms, Stage::symmetries, symmetries_ms.first);
+  addStage(result.kernel_ms, Stage::symmetries, symmetries_ms.second);
   result.pose_wall_ms = msSince(wall0);
   result.pose_cpu_ms = util::processCpuMs() - cpu0;
   result.pose_threads = util::threadsFor(candidates.size(), threads);

@@ -53,10 +53,10 @@ class StageClock {
   }
   /// Ends the stage (less `less` wall and device ms spent in a stage timed inside it, as
   /// split() gave them) and starts the next.
-  void end(const char* stage, DetectionResult& r, std::pair<double, double> less = {0, 0}) {
+  void end(Stage stage, DetectionResult& r, std::pair<double, double> less = {0, 0}) {
     const auto [wall, device] = split();
-    r.timings_ms.emplace_back(stage, wall - less.first);
-    r.kernel_ms.emplace_back(stage, device - less.second);
+    addStage(r.timings_ms, stage, wall - less.first);
+    addStage(r.kernel_ms, stage, device - less.second);
   }
 
  private:

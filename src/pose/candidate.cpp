@@ -8,11 +8,39 @@
 #include <fmt/format.h>
 
 #include "pose/accept.hpp"
+#include "pose/alternatives.hpp"
+#include "pose/appearance.hpp"
 #include "render/render.hpp"
 #include "util/parallel.hpp"
 #include "util/timing.hpp"
 
 namespace vkpose {
+
+/// What stages 6-8 know of each bank's object, but its renderer (Detector::attachRenderers).
+std::vector<PoseObject> poseObjects(const std::vector<TemplateBank>& banks, const DetectorParams& params) {
+  std::vector<PoseObject> objects(banks.size());
+  for (std::size_t b = 0; b < banks.size(); ++b) {
+    objects[b].bank = &banks[b];
+    for (const auto& v : banks[b].mesh.vertices)
+      objects[b].bounding_radius = std::max(objects[b].bounding_radius, (v - banks[b].centre).norm());
+    objects[b].colourful = meshChromaSpread(banks[b].mesh) >= kMinChromaSpread;
+  }
+  // Look-alike half-turns: about 0.1 s a mesh, so found here rather than stored (banks of
+  // every version get them, and the tolerance stays a detection setting).
+  if (params.verify.resolve_symmetries)
+    util::parallelFor(
+        banks.size(),
+        [&](std::size_t b) {
+          const TemplateBank& bank = banks[b];
+          if (bank.symmetric) return;  // scored with ADI: turns do not count against it
+          const float from = std::max(bank.params.near_symmetry_tolerance, 0.01f) * bank.diameter;
+          const float share = isSmallPart(bank.diameter) ? params.verify.small_part_look_alike_tolerance
+                                                         : params.verify.look_alike_tolerance;
+          objects[b].look_alike_turns = findLookAlikeTurns(bank.mesh, from, share * bank.diameter);
+        },
+        params.threads);
+  return objects;
+}
 
 using util::msSince;
 

@@ -43,6 +43,11 @@ struct PoseObject {
   std::vector<NearSymmetry> look_alike_turns;
 };
 
+/// Each bank's PoseObject, but its renderer (the Detector attaches those): its bounding
+/// radius, whether its colours vary, and (verify.resolve_symmetries) its look-alike turns,
+/// about 0.1 s a mesh, so found here rather than stored in the bank.
+std::vector<PoseObject> poseObjects(const std::vector<TemplateBank>& banks, const DetectorParams& params);
+
 /// What stages 6-8 read of one frame.
 struct PoseFrame {
   Camera camera;      ///< with the frame's size

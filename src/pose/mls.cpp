@@ -11,9 +11,11 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <fmt/format.h>
 
 #include "geometry/nearest_neighbours.hpp"
 #include "pose/refine.hpp"
+#include "vkpose/error.hpp"
 
 namespace vkpose {
 
@@ -61,6 +63,14 @@ double polynomialHeight(const PointCloud& points, const std::vector<int>& nn, co
   return normal_matrix.template selfadjointView<Eigen::Upper>().llt().solve(rhs)(0);
 }
 }  // namespace
+
+void validateMls(float radius, int order, float seed_voxel) {
+  if (!(radius > 0.f) || !std::isfinite(radius))
+    throw InputError(fmt::format("MLS radius must be positive and finite, got {}", radius));
+  if (order < 0) throw InputError(fmt::format("MLS polynomial order must be >= 0, got {}", order));
+  if (!(seed_voxel >= 0.f) || !std::isfinite(seed_voxel))
+    throw InputError(fmt::format("MLS seed voxel must be >= 0 and finite, got {}", seed_voxel));
+}
 
 PointCloud smoothMls(const PointCloud& scene, float radius, int order, float seed_voxel, int max_neighbours) {
   validateMls(radius, order, seed_voxel);

@@ -62,7 +62,8 @@ PointCloud smoothMlsPcl(const PointCloud& scene, float radius, int order, float 
 std::vector<std::size_t> voxelSeedIndices(const PointCloud& cloud, float voxel);
 
 /// InputError unless the MLS radius is positive and finite, the polynomial order >= 0 and the
-/// seed voxel >= 0 and finite (src/pipeline/params.cpp, beside the other parameter checks).
+/// seed voxel >= 0 and finite: smoothMls and smoothMlsPcl check the lengths they are given
+/// (scaled per object), which the config table's ranges never saw.
 void validateMls(float radius, int order, float seed_voxel);
 
 /// For each query, the index of its nearest point of `cloud` by PCL's k-d tree (KdTreeFLANN),

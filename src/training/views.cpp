@@ -10,15 +10,6 @@
 
 namespace vkpose {
 
-std::vector<float> SteppedRange::values() const {
-  std::vector<float> out;
-  if (step <= 0.f) return {from};
-  // Index-based so that rounding never drops the last value or adds one past `to`.
-  const int n = static_cast<int>(std::floor((to - from) / step + 1e-4f)) + 1;
-  for (int i = 0; i < n; ++i) out.push_back(from + static_cast<float>(i) * step);
-  return out;
-}
-
 SteppedRange parseSteppedRange(const std::string& text, const std::string& what) {
   SteppedRange r;
   float a = 0.f, b = 0.f, s = 0.f;
