@@ -222,29 +222,11 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
 
 }  // namespace
 
-Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
-  auto opt = std::make_shared<EvalOptions>();
-  auto& p = opt->params;
-  auto* sub = app.add_subcommand(
-      "eval", "Score vkpose and the paper's baselines (linemod, ppf) side by side on a BOP dataset");
-  sub->add_option("--dataset", opt->dataset, "BOP dataset folder (camera.json, models/, SPLIT/SCENE/...)")->required();
-  sub->add_option("--split", opt->split, "Split folder of the dataset")->capture_default_str();
-  sub->add_option("--bank", opt->banks,
-                  "OBJ_ID=BANK: the template bank (.vkpb) of BOP object OBJ_ID; repeat for several objects. The "
-                  "evaluated objects are these");
-  sub->add_option("--method", opt->methods, "Method to run: vkpose, linemod or ppf; repeat (default: all three)");
-  sub->add_option("--out", opt->out,
-                  "BOP results CSV, one per method: METHOD_ is put before the file name (--out r/lmo-test.csv writes "
-                  "r/vkpose_lmo-test.csv, ...)");
-  sub->add_option("--report", opt->report, "JSON report to write (per method: average and per-object scores)");
-  sub->add_option("--pr-curve", opt->pr_curve,
-                  "Precision-recall curves to write (per method, all objects and each object: precision, recall "
-                  "and F1 of the estimates scoring at least each threshold): CSV, or an SVG plot when FILE ends in .svg");
-  sub->add_option("--images", p.max_images, "Evaluate the first N images only (0: all)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
-  addParamFlag(sub, p.detector, "--threads", "; with --workers, the cores shared out among the workers");
+namespace {
+
+/// `--workers`, `--dask` and their settings.
+void addSpreadOptions(CLI::App* sub, EvalOptions& o) {
+  auto* opt = &o;
   auto* spread = "Spread over Dask's workers (python3-distributed; docs/evaluation.md)";
   auto* workers = sub->add_option("--workers", opt->dask.workers,
                                   "Run the images on N worker processes of a Dask cluster on this machine")
@@ -262,8 +244,11 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--batch", opt->dask.batch, "Images per Dask task (0: about 4 tasks a worker)")
       ->check(CLI::Range(0, 100000))
       ->group(spread);
-  addConfigOption(sub, opt->config);
-  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+}
+
+/// `--grasps` and how picks are ordered and checked.
+void addPickingOptions(CLI::App* sub, EvalOptions& o) {
+  auto* opt = &o;
   auto* picking = "Bin picking (docs/picking.md)";
   sub->add_option("--grasps", opt->grasps,
                   "Grasp file of an object: plan each image's picks (the bin from SCENE/bin/IMAGE.json when synth "
@@ -277,6 +262,10 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str()
       ->group(picking);
+}
+
+/// What counts as a correct estimate, and which instances count.
+void addProtocolOptions(CLI::App* sub, EvalRunParams& p) {
   auto* protocol = "Evaluation protocol";
   sub->add_option("--k-m", p.eval.k_m, "An estimate is correct when its ADD/ADI is below k_m times the diameter")
       ->check(CLI::Range(0.001, 10.0))
@@ -304,6 +293,10 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str()
       ->group(protocol);
+}
+
+/// The methods' own parameters.
+void addMethodOptions(CLI::App* sub, EvalRunParams& p) {
   auto* methods = "Method parameters";
   addParamFlag(sub, p.detector, "--threshold", ", vkpose and linemod")->group(methods);
   sub->add_option("--linemod-max-per-object", p.linemod.max_per_object,
@@ -324,6 +317,39 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.02, 1.0))
       ->capture_default_str()
       ->group(methods);
+}
+
+}  // namespace
+
+Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
+  auto opt = std::make_shared<EvalOptions>();
+  auto& p = opt->params;
+  auto* sub = app.add_subcommand(
+      "eval", "Score vkpose and the paper's baselines (linemod, ppf) side by side on a BOP dataset");
+  sub->add_option("--dataset", opt->dataset, "BOP dataset folder (camera.json, models/, SPLIT/SCENE/...)")->required();
+  sub->add_option("--split", opt->split, "Split folder of the dataset")->capture_default_str();
+  sub->add_option("--bank", opt->banks,
+                  "OBJ_ID=BANK: the template bank (.vkpb) of BOP object OBJ_ID; repeat for several objects. The "
+                  "evaluated objects are these");
+  sub->add_option("--method", opt->methods, "Method to run: vkpose, linemod or ppf; repeat (default: all three)");
+  sub->add_option("--out", opt->out,
+                  "BOP results CSV, one per method: METHOD_ is put before the file name (--out r/lmo-test.csv writes "
+                  "r/vkpose_lmo-test.csv, ...)");
+  sub->add_option("--report", opt->report, "JSON report to write (per method: average and per-object scores)");
+  sub->add_option("--pr-curve", opt->pr_curve,
+                  "Precision-recall curves to write (per method, all objects and each object: precision, recall "
+                  "and F1 of the estimates scoring at least each threshold): CSV, or an SVG plot when FILE ends in .svg");
+  sub->add_option("--images", p.max_images, "Evaluate the first N images only (0: all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_flag("--force", opt->force, "Overwrite --out and --report files that exist");
+  addParamFlag(sub, p.detector, "--threads", "; with --workers, the cores shared out among the workers");
+  addSpreadOptions(sub, *opt);
+  addConfigOption(sub, opt->config);
+  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  addPickingOptions(sub, *opt);
+  addProtocolOptions(sub, p);
+  addMethodOptions(sub, p);
   return [opt, &global]() {
     opt->pick.order = parsePickOrder(opt->pick_order);
     return runEval(*opt, global);

@@ -14,7 +14,7 @@ constexpr int kGauss7[7] = {8, 28, 56, 72, 56, 28, 8};
 
 // Orientation bin edges at 11.25, 33.75, 56.25 and 78.75 degrees as tan(edge) * 2^19,
 // rounded. For |gx|, |gy| <= 1020 the comparisons gy * 2^19 >= |gx| * kTan[i] decide every
-// integer pair exactly (tests/orientation_bins_test.cpp checks all of them).
+// integer pair exactly (tests/match/orientation_bins_test.cpp checks all of them).
 constexpr uint32_t kTanEdge[4] = {104287u, 350318u, 784652u, 2635774u};
 
 }  // namespace

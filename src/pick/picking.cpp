@@ -329,6 +329,48 @@ std::string gripperCollision(const Grasp& grasp, const Pose& camera_T_gripper, c
                                                                   : fmt::format("obstacle {}", hit));
 }
 
+namespace {
+
+/// What a placed grasp meets: the other detections' surfaces (and their indices), the part's
+/// own surface, the depth image, the bin.
+struct GraspSurroundings {
+  const std::vector<Detection>& detections;
+  const std::vector<const std::vector<Eigen::Vector3f>*>& others;
+  const std::vector<std::size_t>& other_index;
+  const NearestNeighbours& own;
+  const cv::Mat& depth_m;
+  const Camera& camera;
+  const std::optional<BinBox>& bin;
+  const PickParams& params;
+};
+
+/// Why the grasp `p` (placed from `g`) is refused: too tilted, hitting the bin, another
+/// detection or scene points; "" when it is valid, with its clearance set.
+std::string refusal(PlacedGrasp& p, const Grasp& g, const GraspSurroundings& at) {
+  const PickParams& params = at.params;
+  if (p.tilt_deg > params.max_tilt_deg)
+    return fmt::format("approach tilted {:.0f} degrees from the approach axis (at most {:.0f})", p.tilt_deg,
+                       params.max_tilt_deg);
+  const SweptGripper swept(g);
+  if (at.bin) {
+    std::string why = binCollision(swept, p.pose, *at.bin);
+    if (!why.empty()) return why;
+  }
+  const auto [hit, nearest] = pointCollision(swept, p.pose, at.others, params.clearance_m);
+  if (hit >= 0) {
+    const std::size_t other = at.other_index[static_cast<std::size_t>(hit)];
+    return fmt::format("hits detection {} ({})", other, at.detections[other].object);
+  }
+  const SceneClearance scene =
+      sceneClearance(swept, p.pose, at.depth_m, at.camera, at.own, params.part_tolerance_m, params.clearance_m);
+  p.clearance_m = std::min(nearest, scene.nearest_m);
+  if (scene.inside >= params.min_blocking_points)
+    return fmt::format("{} scene points in the gripper's way (something lies on or beside the part)", scene.inside);
+  return {};
+}
+
+}  // namespace
+
 PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<TemplateBank>& banks,
                    const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
                    const std::optional<BinBox>& bin, const PickParams& params) {
@@ -375,29 +417,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
       std::string first_reason;
       for (const std::size_t k : idx) {
         PlacedGrasp p = copies[name][k];
-        const Grasp& g = *sources[name][k];
-        std::string why;
-        if (p.tilt_deg > params.max_tilt_deg) {
-          why = fmt::format("approach tilted {:.0f} degrees from the approach axis (at most {:.0f})", p.tilt_deg,
-                            params.max_tilt_deg);
-        } else {
-          const SweptGripper swept(g);
-          if (bin) why = binCollision(swept, p.pose, *bin);
-          if (why.empty()) {
-            const auto [hit, nearest] = pointCollision(swept, p.pose, others, params.clearance_m);
-            if (hit >= 0) {
-              const Detection& o = detections[other_index[static_cast<std::size_t>(hit)]];
-              why = fmt::format("hits detection {} ({})", other_index[static_cast<std::size_t>(hit)], o.object);
-            } else {
-              const SceneClearance scene = sceneClearance(swept, p.pose, depth_m, camera, own, params.part_tolerance_m,
-                                                          params.clearance_m);
-              if (scene.inside >= params.min_blocking_points)
-                why = fmt::format("{} scene points in the gripper's way (something lies on or beside the part)",
-                                  scene.inside);
-              p.clearance_m = std::min(nearest, scene.nearest_m);
-            }
-          }
-        }
+        const std::string why = refusal(p, *sources[name][k], {detections, others, other_index, own, depth_m, camera, bin, params});
         if (why.empty()) {
           out.valid.push_back(p);
           first_reason.clear();

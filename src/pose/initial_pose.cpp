@@ -185,6 +185,57 @@ PointCloud visibleModelPoints(const Rendering& rendering, const Pose& pose, cons
   return out;
 }
 
+namespace {
+
+/// The rendered object's pixels in the window: their count, box (scene pixels) and depth range.
+struct RenderedExtent {
+  std::size_t pixels = 0;
+  cv::Rect box;
+  float z_min = std::numeric_limits<float>::max(), z_max = 0.f;
+};
+
+RenderedExtent renderedExtent(const cv::Mat& rendered_depth, const cv::Rect& window) {
+  RenderedExtent e;
+  for (int v = window.y; v < window.y + window.height; ++v) {
+    const float* zr = rendered_depth.ptr<float>(v - window.y);
+    for (int u = window.x; u < window.x + window.width; ++u) {
+      const float z = zr[u - window.x];
+      if (!(z > 0.f)) continue;
+      ++e.pixels;
+      e.box |= cv::Rect(u, v, 1, 1);
+      e.z_min = std::min(e.z_min, z);
+      e.z_max = std::max(e.z_max, z);
+    }
+  }
+  return e;
+}
+
+/// The scene crop around the model rendered at `centre` and moved by `shift`: its box (moved
+/// by the move's projection) grown by the margin, depths within the band of its moved depth
+/// range.
+PointCloud sceneCrop(const cv::Mat& scene_depth_m, const Camera& camera, const RenderedExtent& extent,
+                     const Eigen::Vector3f& centre, const Eigen::Vector3d& shift, float margin_fraction, float band) {
+  const cv::Rect& box = extent.box;
+  const Eigen::Vector3f centre_after = centre + shift.cast<float>();
+  const Eigen::Vector2f image_shift = camera.project(centre_after) - camera.project(centre);
+  const int mx = static_cast<int>(std::ceil(margin_fraction * static_cast<float>(box.width)));
+  const int my = static_cast<int>(std::ceil(margin_fraction * static_cast<float>(box.height)));
+  cv::Rect crop(box.x + static_cast<int>(std::lround(image_shift.x())) - mx,
+                box.y + static_cast<int>(std::lround(image_shift.y())) - my, box.width + 2 * mx, box.height + 2 * my);
+  crop &= cv::Rect(0, 0, scene_depth_m.cols, scene_depth_m.rows);
+  const float near = extent.z_min + static_cast<float>(shift.z()) - band;
+  const float far = extent.z_max + static_cast<float>(shift.z()) + band;
+  PointCloud points;
+  for (int v = crop.y; v < crop.y + crop.height; ++v) {
+    const float* zs = scene_depth_m.ptr<float>(v);
+    for (int u = crop.x; u < crop.x + crop.width; ++u)
+      if (zs[u] > near && zs[u] < far) points.push_back(camera.backProject(u, v, zs[u]));
+  }
+  return points;
+}
+
+}  // namespace
+
 InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered, const cv::Mat& scene_depth_m,
                                const Camera& camera, float diameter, const InitialPoseParams& params,
                                const cv::Rect& window_in) {
@@ -201,20 +252,9 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
   out.pose = rendered;
   Eigen::Vector3d scene_sum = Eigen::Vector3d::Zero(), model_sum = Eigen::Vector3d::Zero();
   std::size_t model_count = 0;
-  cv::Rect box;  // the rendered object's pixels
-  float z_min = std::numeric_limits<float>::max(), z_max = 0.f;
   out.model_points = visibleModelPoints(rendering, rendered, camera, window);
-  for (int v = window.y; v < window.y + window.height; ++v) {
-    const float* zr = rendering.depth.ptr<float>(v - window.y);
-    for (int u = window.x; u < window.x + window.width; ++u) {
-      const float z = zr[u - window.x];
-      if (!(z > 0.f)) continue;
-      ++out.mask_pixels;
-      box |= cv::Rect(u, v, 1, 1);
-      z_min = std::min(z_min, z);
-      z_max = std::max(z_max, z);
-    }
-  }
+  const RenderedExtent extent = renderedExtent(rendering.depth, window);
+  out.mask_pixels = extent.pixels;
   if (out.mask_pixels == 0) {
     out.why = "the model renders outside the image";
     return out;
@@ -272,21 +312,7 @@ InitialPose initialTranslation(const Rendering& rendering, const Pose& rendered,
                                 model_sum / static_cast<double>(model_count);
   out.pose.t = rendered.t + shift.cast<float>();
 
-  // The crop around the moved model: its box (moved by the shift's projection) grown by the
-  // margin, depths within the band of its moved depth range.
-  const Eigen::Vector3f centre_before = rendered.t, centre_after = out.pose.t;
-  const Eigen::Vector2f image_shift = camera.project(centre_after) - camera.project(centre_before);
-  const int mx = static_cast<int>(std::ceil(params.crop_margin_fraction * static_cast<float>(box.width)));
-  const int my = static_cast<int>(std::ceil(params.crop_margin_fraction * static_cast<float>(box.height)));
-  cv::Rect crop(box.x + static_cast<int>(std::lround(image_shift.x())) - mx,
-                box.y + static_cast<int>(std::lround(image_shift.y())) - my, box.width + 2 * mx, box.height + 2 * my);
-  crop &= cv::Rect(0, 0, scene_depth_m.cols, scene_depth_m.rows);
-  const float near = z_min + static_cast<float>(shift.z()) - band, far = z_max + static_cast<float>(shift.z()) + band;
-  for (int v = crop.y; v < crop.y + crop.height; ++v) {
-    const float* zs = scene_depth_m.ptr<float>(v);
-    for (int u = crop.x; u < crop.x + crop.width; ++u)
-      if (zs[u] > near && zs[u] < far) out.scene_points.push_back(backProject(u, v, zs[u]));
-  }
+  out.scene_points = sceneCrop(scene_depth_m, camera, extent, rendered.t, shift, params.crop_margin_fraction, band);
   out.ok = true;
   return out;
 }

@@ -13,7 +13,7 @@ constexpr float kDetectionRenderError = 0.002f;
 
 /// Edge collapses (meshoptimizer's quadric simplifier) while the surface moves by about
 /// `max_error_m` at most: the bound is meshoptimizer's quadric estimate, which on a sphere
-/// undershoots (the surface moved up to 1.7 times it; tests/render_test.cpp). Vertices keep
+/// undershoots (the surface moved up to 1.7 times it; tests/render/render_test.cpp). Vertices keep
 /// their positions, normals and colours (only faces go), and vertices that share a position
 /// but differ in colour or normal are a seam the simplifier keeps, so painted faces keep their
 /// borders. Returns the mesh unchanged when nothing can go.

@@ -326,6 +326,88 @@ namespace {
 
 using util::msSince;
 
+/// Views differing only by in-plane rotation share one rendering: the GPU renders each
+/// (viewpoint, distance) once and the rotations are image rotations of it (exact for a
+/// pinhole camera with square pixels, up to nearest-neighbour resampling). `bases` are the
+/// renderings' poses, `members[b]` the views (indices, in order) that turn rendering b.
+struct RenderingGroups {
+  std::vector<Pose> bases;
+  std::vector<std::vector<std::size_t>> members;
+};
+
+RenderingGroups groupByRendering(const std::vector<TrainingView>& views) {
+  RenderingGroups g;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (i == 0 || views[i].viewpoint != views[i - 1].viewpoint || views[i].distance != views[i - 1].distance) {
+      const float a = -views[i].inplane_deg * static_cast<float>(CV_PI / 180.0);
+      const Eigen::Matrix3f undo = Eigen::AngleAxisf(a, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+      g.bases.push_back({undo * views[i].R, undo * views[i].t});
+      g.members.emplace_back();
+    }
+    g.members.back().push_back(i);
+  }
+  return g;
+}
+
+/// The templates of `view_ids` (views[view_ids[i]] turns renders[render_of[i]]): each view
+/// turned in-plane and cut to its feature crop, quantized (on the GPU in one go when there is
+/// a quantizer, one by one by the CPU reference otherwise) and its features selected. A view
+/// that gives no template is left without levels.
+std::vector<BankTemplate> chunkTemplates(const std::vector<Rendering>& renders, const std::vector<TrainingView>& views,
+                                         const std::vector<std::size_t>& view_ids,
+                                         const std::vector<std::size_t>& render_of, ViewQuantizer* quantizer,
+                                         const TrainingParams& params, const Camera& tile) {
+  const std::size_t m = view_ids.size();
+  struct Cropped {
+    Rendering crop;
+    cv::Rect roi, object;
+  };
+  std::vector<Cropped> cropped(m);
+  util::parallelFor(m, [&](std::size_t i) {
+    const Rendering view = rotateInPlane(renders[render_of[i]], views[view_ids[i]].inplane_deg, tile.cx, tile.cy);
+    Cropped& v = cropped[i];
+    v.object = cv::boundingRect(view.mask());
+    if (v.object.empty()) return;
+    v.roi = featureCrop(v.object, view.depth.size(), params.features.T.size());
+    v.crop = {view.depth(v.roi).clone(), view.normals(v.roi).clone(), view.bgr(v.roi).clone()};
+  });
+  std::vector<std::size_t> seen;
+  for (std::size_t i = 0; i < m; ++i)
+    if (!cropped[i].object.empty()) seen.push_back(i);
+  std::vector<QuantizedView> quantized(m);
+  if (quantizer) {
+    std::vector<LinemodFrame> frames(seen.size());
+    util::parallelFor(seen.size(), [&](std::size_t k) {
+      frames[k] = {cropped[seen[k]].crop.bgr, depthMillimetres(cropped[seen[k]].crop.depth)};
+    });
+    auto q = quantizer->quantize(frames);
+    for (std::size_t k = 0; k < seen.size(); ++k) quantized[seen[k]] = std::move(q[k]);
+  } else {
+    util::parallelFor(seen.size(), [&](std::size_t k) {
+      quantized[seen[k]] = quantizeView(cropped[seen[k]].crop, params.features);
+    });
+  }
+  std::vector<BankTemplate> made(m);  // no levels: the view gave no template
+  util::parallelFor(m, [&](std::size_t i) {
+    const Cropped& v = cropped[i];
+    if (v.object.empty()) return;
+    const ExtractedTemplate e = selectFeatures(quantized[i], v.crop.mask(), v.roi, v.object, params);
+    if (!e.ok) return;
+    const TrainingView& view = views[view_ids[i]];
+    BankTemplate& bt = made[i];
+    bt.linemod = e.linemod;
+    bt.pose = {view.R, view.t};
+    bt.distance = view.distance;
+    bt.inplane_deg = view.inplane_deg;
+    bt.viewpoint = view.viewpoint;
+    bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
+    bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
+    // The object's box and the template's origin in crop pixels.
+    bt.crop = cropRendering(v.crop, e.object - v.roi.tl(), e.origin_x - v.roi.x, e.origin_y - v.roi.y);
+  });
+  return made;
+}
+
 }  // namespace
 
 TemplateBank trainTemplates(const GpuContext& ctx, const Mesh& mesh, const TrainingParams& params,
@@ -356,20 +438,7 @@ TemplateBank trainTemplatesWith(const GpuContext& ctx, const Mesh& mesh, const T
   bank.params = params;
   bank.near_symmetries = findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter);
   const Camera tile = trainingCamera(mesh, params, views);
-  // Views differing only by in-plane rotation share one rendering: the GPU renders each
-  // (viewpoint, distance) once and the rotations are image rotations of it (exact for a
-  // pinhole camera with square pixels, up to nearest-neighbour resampling).
-  std::vector<Pose> bases;
-  std::vector<std::vector<std::size_t>> members;
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    if (i == 0 || views[i].viewpoint != views[i - 1].viewpoint || views[i].distance != views[i - 1].distance) {
-      const float a = -views[i].inplane_deg * static_cast<float>(CV_PI / 180.0);
-      const Eigen::Matrix3f undo = Eigen::AngleAxisf(a, Eigen::Vector3f::UnitZ()).toRotationMatrix();
-      bases.push_back({undo * views[i].R, undo * views[i].t});
-      members.emplace_back();
-    }
-    members.back().push_back(i);
-  }
+  const RenderingGroups groups = groupByRendering(views);
   MeshRenderer renderer(ctx, mesh);
   std::unique_ptr<ViewQuantizer> quantizer;
   if (quantization == FeatureQuantization::gpu) quantizer = std::make_unique<ViewQuantizer>(ctx, params.features);
@@ -378,73 +447,29 @@ TemplateBank trainTemplatesWith(const GpuContext& ctx, const Mesh& mesh, const T
   constexpr std::size_t kViewsPerChunk = 128;
   TrainingTimings t;
   std::size_t done = 0;
-  for (std::size_t first = 0; first < bases.size(); first += per_batch) {
-    const std::size_t n = std::min(per_batch, bases.size() - first);
+  for (std::size_t first = 0; first < groups.bases.size(); first += per_batch) {
+    const std::size_t n = std::min(per_batch, groups.bases.size() - first);
     auto t0 = std::chrono::steady_clock::now();
-    const auto renders = renderer.render(tile, std::vector<Pose>(bases.begin() + first, bases.begin() + first + n));
+    const auto renders =
+        renderer.render(tile, std::vector<Pose>(groups.bases.begin() + first, groups.bases.begin() + first + n));
     t.render_ms += msSince(t0);
     t0 = std::chrono::steady_clock::now();
     std::vector<std::size_t> todo;
     std::vector<std::size_t> render_of;
     for (std::size_t b = first; b < first + n; ++b)
-      for (std::size_t v : members[b]) {
+      for (std::size_t v : groups.members[b]) {
         todo.push_back(v);
         render_of.push_back(b - first);
       }
     for (std::size_t c = 0; c < todo.size(); c += kViewsPerChunk) {
       const std::size_t m = std::min(kViewsPerChunk, todo.size() - c);
-      // Each view turned in-plane and cut to its feature crop (featureCrop).
-      struct Cropped {
-        Rendering crop;
-        cv::Rect roi, object;
+      const auto part = [&](const std::vector<std::size_t>& all) {
+        return std::vector<std::size_t>(all.begin() + static_cast<std::ptrdiff_t>(c),
+                                        all.begin() + static_cast<std::ptrdiff_t>(c + m));
       };
-      std::vector<Cropped> cropped(m);
-      util::parallelFor(m, [&](std::size_t i) {
-        const Rendering view = rotateInPlane(renders[render_of[c + i]], views[todo[c + i]].inplane_deg, tile.cx, tile.cy);
-        Cropped& v = cropped[i];
-        v.object = cv::boundingRect(view.mask());
-        if (v.object.empty()) return;
-        v.roi = featureCrop(v.object, view.depth.size(), params.features.T.size());
-        v.crop = {view.depth(v.roi).clone(), view.normals(v.roi).clone(), view.bgr(v.roi).clone()};
-      });
-      // Quantized on the GPU in one go, or one by one by the CPU reference.
-      std::vector<std::size_t> seen;
-      for (std::size_t i = 0; i < m; ++i)
-        if (!cropped[i].object.empty()) seen.push_back(i);
-      std::vector<QuantizedView> quantized(m);
-      if (quantizer) {
-        std::vector<LinemodFrame> frames(seen.size());
-        util::parallelFor(seen.size(), [&](std::size_t k) {
-          frames[k] = {cropped[seen[k]].crop.bgr, depthMillimetres(cropped[seen[k]].crop.depth)};
-        });
-        auto q = quantizer->quantize(frames);
-        for (std::size_t k = 0; k < seen.size(); ++k) quantized[seen[k]] = std::move(q[k]);
-      } else {
-        util::parallelFor(seen.size(), [&](std::size_t k) {
-          quantized[seen[k]] = quantizeView(cropped[seen[k]].crop, params.features);
-        });
-      }
-      std::vector<BankTemplate> made(m);  // no levels: the view gave no template
-      util::parallelFor(m, [&](std::size_t i) {
-        const Cropped& v = cropped[i];
-        if (v.object.empty()) return;
-        const ExtractedTemplate e = selectFeatures(quantized[i], v.crop.mask(), v.roi, v.object, params);
-        if (!e.ok) return;
-        const TrainingView& view = views[todo[c + i]];
-        BankTemplate& bt = made[i];
-        bt.linemod = e.linemod;
-        bt.pose = {view.R, view.t};
-        bt.distance = view.distance;
-        bt.inplane_deg = view.inplane_deg;
-        bt.viewpoint = view.viewpoint;
-        bt.anchor_x = static_cast<float>(tile.cx - e.origin_x);
-        bt.anchor_y = static_cast<float>(tile.cy - e.origin_y);
-        // The object's box and the template's origin in crop pixels.
-        bt.crop = cropRendering(v.crop, e.object - v.roi.tl(), e.origin_x - v.roi.x, e.origin_y - v.roi.y);
-      });
-      for (std::size_t i = 0; i < m; ++i) {
-        if (!made[i].linemod.levels.empty())
-          bank.templates.push_back(std::move(made[i]));
+      for (BankTemplate& made : chunkTemplates(renders, views, part(todo), part(render_of), quantizer.get(), params, tile)) {
+        if (!made.linemod.levels.empty())
+          bank.templates.push_back(std::move(made));
         else
           ++t.dropped;
       }

@@ -1,0 +1,192 @@
+// Bin picking: grasp files are checked value by value; a symmetric part's grasp is offered at
+// every angle the part lies at; grasps are refused where the gripper would hit the bin's wall,
+// another detection or the scene, with the reason; the first pick is checked against the truth.
+// Geometry built in code: no data needed.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "synth/procedural_meshes.hpp"
+#include "mesh_support.hpp"
+#include "test_support.hpp"
+#include "vkpose/picking.hpp"
+
+namespace vkpose {
+namespace {
+
+/// A bank holding only what picking uses: a 8 cm wide, 10 cm tall cylinder ("can"), symmetric
+/// about +z through the origin.
+TemplateBank canBank() {
+  TemplateBank bank;
+  bank.object = "can";
+  bank.mesh = procedural::lathe({{0.f, -0.05f}, {0.04f, -0.05f}, {0.04f, 0.05f}, {0.f, 0.05f}}, 48, {0.5f, 0.5f, 0.5f});
+  finishMesh(bank.mesh);
+  bank.diameter = bank.mesh.diameter;
+  bank.symmetric = true;
+  return bank;
+}
+
+const char* kSideGrasp = R"({"object": "can",
+  "gripper": {"shape": "cylinder", "radius_mm": 15, "length_mm": 120},
+  "grasps": [{"name": "side", "priority": 1, "position_mm": [40, 0, 0], "approach": [-1, 0, 0], "x": [0, 0, 1],
+              "approach_distance_mm": 80, "retreat_distance_mm": 80, "suction_radius_mm": 10}]})";
+
+Detection detectionAt(const Pose& pose) {
+  Detection d;
+  d.object = "can";
+  d.score = 0.9f;
+  d.pose = pose;
+  return d;
+}
+
+/// The can lying on its side (axis along the camera's x) at 0.8 m, turned about its axis by `roll`.
+Pose lyingCan(float roll_deg, float x = 0.f) {
+  Pose p;
+  p.R = Eigen::AngleAxisf(roll_deg * 3.14159265f / 180.f, Eigen::Vector3f::UnitX()).toRotationMatrix() *
+        Eigen::AngleAxisf(3.14159265f / 2, Eigen::Vector3f::UnitY()).toRotationMatrix();
+  p.t = {x, 0.f, 0.8f};
+  return p;
+}
+
+Camera camera() {
+  Camera c;
+  c.width = 640, c.height = 480;
+  return c;
+}
+
+TEST(Picking, GraspFilesAreCheckedValueByValue) {
+  const GraspSet set = parseGrasps(kSideGrasp, "can.json");
+  ASSERT_EQ(set.object, "can");
+  ASSERT_EQ(set.grasps.size(), 1u);
+  const Grasp& g = set.grasps[0];
+  EXPECT_TRUE(g.pose.R.col(2).isApprox(Eigen::Vector3f(-1, 0, 0)));  // z is the approach
+  EXPECT_TRUE(g.pose.t.isApprox(Eigen::Vector3f(0.04f, 0, 0)));      // millimetres read as such
+  EXPECT_FLOAT_EQ(g.gripper.radius, 0.015f);
+  EXPECT_FLOAT_EQ(g.suction_radius_m, 0.01f);
+
+  auto bad = [](const std::string& grasp) {
+    return R"({"object": "can", "grasps": [)" + grasp + "]}";
+  };
+  test::expectInputError([&] { parseGrasps(bad(R"({"name": "a", "position_mm": [0,0,0], "approach": [0,0,2], "opening_mm": 5})"), "f.json"); },
+                         {"f.json", "grasp 'a'", "not a unit vector"});
+  test::expectInputError([&] { parseGrasps(bad(R"({"name": "a", "position_mm": [0,"nan",0], "approach": [0,0,1], "opening_mm": 5})"), "f.json"); },
+                         {"grasp 'a'", "position_mm", "not a number"});
+  test::expectInputError([&] { parseGrasps(bad(R"({"name": "a", "position_mm": [0,0,0], "approach": [0,0,1]})"), "f.json"); },
+                         {"opening", "suction_radius"});
+  test::expectInputError([&] { parseGrasps(bad(R"({"name": "a", "position_mm": [0,0,0], "approach": [0,0,1], "x": [0,1,1], "opening_mm": 5})"), "f.json"); },
+                         {"'x'"});
+  test::expectInputError([&] { parseGrasps(bad(R"({"name": "a", "position_m": [0,0,0], "approach": [0,0,1], "opening_mm": -5})"), "f.json"); },
+                         {"negative"});
+  test::expectInputError([] { parseGrasps(R"({"object": "can", "grasps": []})", "f.json"); }, {"at least one grasp"});
+  test::expectInputError([] { parseGrasps(R"({"grasps": []})", "f.json"); }, {"\"object\""});
+  test::expectInputError([] { parseGrasps("{not json", "f.json"); }, {"f.json", "not JSON"});
+  test::expectInputError([] { parsePickOrder("random"); }, {"combined, height, score or visible"});
+}
+
+TEST(Picking, ASymmetricPartsGraspIsOfferedAtEveryAngleItLiesAt) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> side = parseGrasps(kSideGrasp, "can.json").grasps;
+  const std::vector<Grasp> expanded = expandBySymmetry(side, bank, 36);
+  EXPECT_EQ(expanded.size(), 36u);
+  PickParams params;
+  for (int roll = 0; roll < 360; roll += 25) {
+    const std::vector<Detection> dets = {detectionAt(lyingCan(static_cast<float>(roll)))};
+    const PickPlan with = planPicks(dets, {bank}, {expanded}, cv::Mat(), camera(), std::nullopt, params);
+    ASSERT_EQ(with.picks.size(), 1u) << "roll " << roll;
+    EXPECT_LE(with.picks[0].grasp.tilt_deg, 5.01f) << "roll " << roll;  // a copy every 10 degrees
+    // Its tool centre point stays on the can's surface, facing the camera.
+    EXPECT_NEAR((with.picks[0].grasp.pose.t - dets[0].pose.t).norm(), 0.04f, 1e-4f);
+  }
+  // Without the copies most angles are refused, for the tilt, with the reason.
+  const PickPlan without = planPicks({detectionAt(lyingCan(120.f))}, {bank}, {side}, cv::Mat(), camera(), std::nullopt,
+                                     params);
+  EXPECT_TRUE(without.picks.empty());
+  ASSERT_EQ(without.detections[0].refused.size(), 1u);
+  EXPECT_NE(without.detections[0].refused[0].reason.find("tilted"), std::string::npos);
+}
+
+TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  // A bin seen from 0.8 m above its floor centre, 30 x 20 cm, walls 15 cm high: the camera looks
+  // down its -z (bin frame z up).
+  BinBox bin;
+  bin.pose.R = Eigen::AngleAxisf(3.14159265f, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  bin.pose.t = {0.f, 0.f, 0.84f};
+  bin.inner = {0.3f, 0.2f, 0.15f};
+  bin.wall_thickness_m = 0.01f;
+  PickParams params;
+  // A can in the middle of the floor: clear.
+  const PickPlan clear = planPicks({detectionAt(lyingCan(0.f))}, {bank}, {grasps}, cv::Mat(), camera(), bin, params);
+  ASSERT_EQ(clear.picks.size(), 1u);
+  EXPECT_GT(clear.picks[0].height, 0.f);
+  // The same grasp with a gripper 30 cm wide reaches the walls.
+  std::vector<Grasp> wide = grasps;
+  for (Grasp& g : wide) g.gripper.radius = 0.15f;
+  const PickPlan walls = planPicks({detectionAt(lyingCan(0.f))}, {bank}, {wide}, cv::Mat(), camera(), bin, params);
+  EXPECT_TRUE(walls.picks.empty());
+  ASSERT_EQ(walls.detections[0].refused.size(), 1u);
+  EXPECT_NE(walls.detections[0].refused[0].reason.find("hits the bin's wall"), std::string::npos)
+      << walls.detections[0].refused[0].reason;
+  // A second can lying across the first one's approach, nearer the camera.
+  Pose above = lyingCan(0.f);
+  above.t.z() = 0.72f;
+  const PickPlan blocked = planPicks({detectionAt(lyingCan(0.f)), detectionAt(above)}, {bank}, {grasps}, cv::Mat(),
+                                     camera(), std::nullopt, params);
+  ASSERT_EQ(blocked.detections.size(), 2u);
+  EXPECT_TRUE(blocked.detections[0].valid.empty());
+  EXPECT_NE(blocked.detections[0].refused[0].reason.find("hits detection 1"), std::string::npos)
+      << blocked.detections[0].refused[0].reason;
+  ASSERT_EQ(blocked.picks.size(), 1u);  // the one on top is picked
+  EXPECT_EQ(blocked.picks[0].detection, 1);
+  // Scene points in the way (a board 5 cm above the can, seen in the depth image) refuse it.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(0.70f));
+  const PickPlan board = planPicks({detectionAt(lyingCan(0.f))}, {bank}, {grasps}, depth, camera(), std::nullopt, params);
+  EXPECT_TRUE(board.picks.empty());
+  EXPECT_NE(board.detections[0].refused[0].reason.find("scene points"), std::string::npos);
+  // The plan as JSON.
+  const auto doc = nlohmann::json::parse(pickPlanJson(blocked));
+  EXPECT_EQ(doc.at("picks").size(), 1u);
+  EXPECT_EQ(doc.at("grasps").at(0).at("refused").at(0).at("name"), "side");
+  EXPECT_TRUE(doc.at("picks").at(0).at("grasp").contains("approach_point"));
+}
+
+TEST(Picking, FingersLeaveRoomBesideThePartThatAPalmWouldTake) {
+  // Jaws 10 cm apart under a palm 6 cm in radius; the gripper frame is the camera frame here.
+  Grasp g = parseGrasps(R"({"object": "can", "gripper": {"radius_mm": 60, "length_mm": 150, "finger_length_mm": 60,
+    "finger_width_mm": 20, "finger_thickness_mm": 10}, "grasps": [{"name": "jaws", "position_mm": [0, 0, 0],
+    "approach": [0, 0, 1], "x": [1, 0, 0], "opening_mm": 100}]})",
+                        "jaws.json")
+                  .grasps[0];
+  EXPECT_FLOAT_EQ(g.gripper.finger_length, 0.06f);
+  // Beside the part, between the fingers' planes (y 3 cm, 2 cm back): clear of the fingers.
+  const std::vector<std::vector<Eigen::Vector3f>> beside = {{Eigen::Vector3f(0.f, 0.03f, -0.02f)}};
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, beside, {"a neighbour"}), "");
+  // On a finger's path (x 5.5 cm), or behind the fingers where the palm passes: hit.
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, {{Eigen::Vector3f(0.055f, 0.f, -0.02f)}}, {"a neighbour"}),
+            "hits a neighbour");
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, {{Eigen::Vector3f(0.f, 0.03f, -0.1f)}}, {"a neighbour"}),
+            "hits a neighbour");
+  // Without fingers the palm's cylinder reaches down to the tool centre point.
+  g.gripper.finger_length = 0.f;
+  EXPECT_EQ(gripperCollision(g, Pose{}, std::nullopt, beside, {"a neighbour"}), "hits a neighbour");
+}
+
+TEST(Picking, TheFirstPickIsCheckedAgainstTheTruth) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  const std::vector<Detection> dets = {detectionAt(lyingCan(10.f))};
+  const PickPlan plan = planPicks(dets, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
+  // The truth at another roll: the same instance for a symmetric can (ADI).
+  EXPECT_EQ(firstPickProblem(plan, dets, {bank}, {{0, lyingCan(70.f)}}, std::nullopt), "");
+  EXPECT_NE(firstPickProblem(plan, dets, {bank}, {{0, lyingCan(0.f, 0.05f)}}, std::nullopt).find("no true instance"),
+            std::string::npos);
+  // A true neighbour the detector missed, across the approach: the gripper would hit it.
+  Pose above = lyingCan(0.f);
+  above.t.z() = 0.72f;
+  EXPECT_NE(firstPickProblem(plan, dets, {bank}, {{0, lyingCan(10.f)}, {0, above}}, std::nullopt).find("hits true instance 1"),
+            std::string::npos);
+  EXPECT_EQ(firstPickProblem({}, dets, {bank}, {}, std::nullopt), "no pick");
+}
+
+}  // namespace
+}  // namespace vkpose

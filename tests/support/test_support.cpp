@@ -1,0 +1,113 @@
+#include "test_support.hpp"
+
+#include <filesystem>
+#include <memory>
+#include <random>
+
+#include "match/features.hpp"
+#include "match/matcher.hpp"
+#include "match/opencv_linemod.hpp"
+#include "vkpose/bank.hpp"
+#include "vkpose/device.hpp"
+#include "vkpose/error.hpp"
+#include "vkpose/frame.hpp"
+#include "vkpose/geometry.hpp"
+
+namespace vkpose::test {
+
+std::string sharedData() { return VKPOSE_SHARED_DATA_DIR; }
+
+TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params) {
+  return loadOrTrainBank(context(), mesh, params, sampleViews(params.views, mesh.bboxCentre()), VKPOSE_TEST_CACHE_DIR)
+      .bank;
+}
+
+bool haveSharedData() { return std::filesystem::exists(sharedData() + "/lmo_scene2_frame3/test/000002/rgb/000003.png"); }
+
+LinemodFrame lmoFrame() {
+  const std::string d = sharedData() + "/lmo_scene2_frame3/test/000002/";
+  return loadFrame(d + "rgb/000003.png", d + "depth/000003.png");
+}
+
+LinemodFrame icbinFrame() {
+  const std::string d = sharedData() + "/icbin/scene2/";
+  return loadFrame(d + "rgb/0000.png", d + "depth/0000.png");
+}
+
+std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const FeatureParams& params, int count,
+                                           unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<cv::Rect> regions;
+  std::uniform_int_distribution<int> size(40, 150);
+  for (int i = 0; i < count * 2; ++i) {
+    const int w = std::min(size(rng), frame.bgr.cols), h = std::min(size(rng), frame.bgr.rows);
+    std::uniform_int_distribution<int> x(0, frame.bgr.cols - w), y(0, frame.bgr.rows - h);
+    regions.emplace_back(x(rng), y(rng), w, h);
+  }
+  auto detector = makeOpenCvDetector(params);
+  auto templates = extractOpenCvTemplates(*detector, frame, regions, params);
+  if (templates.size() > static_cast<std::size_t>(count)) templates.resize(static_cast<std::size_t>(count));
+  return templates;
+}
+
+namespace {
+
+std::unique_ptr<GpuContext>& sharedContext() {
+  static std::unique_ptr<GpuContext> ctx;
+  return ctx;
+}
+
+/// Fails the test during which a Vulkan validation error was reported (the release tests run
+/// with VKPOSE_VALIDATION=1, see tests/CMakeLists.txt); the layer's messages are on stderr.
+class ValidationListener : public ::testing::EmptyTestEventListener {
+  uint32_t before_ = 0;
+  void OnTestStart(const ::testing::TestInfo&) override { before_ = GpuContext::processValidationErrors(); }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    // OnTestEnd runs while the test is still the current one: the failure is recorded on it.
+    if (const uint32_t n = GpuContext::processValidationErrors() - before_; n > 0)
+      ADD_FAILURE() << n << " Vulkan validation error(s) during " << info.test_suite_name() << "." << info.name()
+                    << " (the layer's messages are above)";
+  }
+};
+
+/// Destroys the shared context before the test program ends, so that validation errors of
+/// the tear-down (objects left alive) fail the run too.
+class ContextEnvironment : public ::testing::Environment {
+  void TearDown() override {
+    const uint32_t before = GpuContext::processValidationErrors();
+    sharedContext().reset();
+    if (const uint32_t n = GpuContext::processValidationErrors() - before; n > 0)
+      ADD_FAILURE() << n << " Vulkan validation error(s) while destroying the shared context";
+  }
+};
+
+[[maybe_unused]] const bool kRegistered = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ValidationListener);
+  ::testing::AddGlobalTestEnvironment(new ContextEnvironment);
+  return true;
+}();
+
+}  // namespace
+
+GpuContext& context() {
+  auto& ctx = sharedContext();
+  if (!ctx) ctx = std::make_unique<GpuContext>();
+  return *ctx;
+}
+
+std::string inputErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return {};
+}
+
+void expectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
+  const std::string message = inputErrorOf(f);
+  for (const auto& p : parts) EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' missing from: " << message;
+}
+
+}  // namespace vkpose::test
