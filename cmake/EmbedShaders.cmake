@@ -3,6 +3,10 @@
 # Compiles each GLSL compute shader to SPIR-V with glslc at build time and embeds the words
 # in a static library TARGET. C++ refers to a kernel through the generated enum
 # vkpose::gpu::ShaderId (one value per file stem), never through a path.
+#
+# Kernels include their shared .glsl files from shaders/ and the constants and push-constant
+# structs they share with C++ from src/ ("gpu/kernel_interface.h"). glslc's depfile (-MD)
+# lists every file a kernel included, so editing any of them rebuilds that kernel.
 function(vkpose_embed_shaders target)
   set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/generated/shaders)
   file(MAKE_DIRECTORY ${out_dir})
@@ -16,7 +20,7 @@ function(vkpose_embed_shaders target)
     add_custom_command(
       OUTPUT ${inc}
       COMMAND Vulkan::glslc --target-env=vulkan1.2 -O -Werror -mfmt=c
-              -I ${CMAKE_CURRENT_SOURCE_DIR}/shaders -MD -MF ${inc}.d -o ${inc} ${src}
+              -I ${CMAKE_CURRENT_SOURCE_DIR}/shaders -I ${PROJECT_SOURCE_DIR}/src -MD -MF ${inc}.d -o ${inc} ${src}
       DEPENDS ${src}
       DEPFILE ${inc}.d
       COMMENT "glslc ${stem}.comp"

@@ -3,19 +3,13 @@
 // normal crop with the scene at the hypothesis's centre (two passes: the mean depth offset,
 // then the truncated depth error and the normal angle). The GLSL twin of scoreMember in
 // src/hypotheses/cluster_score_math.hpp: same operations in the same order.
-layout(local_size_x = 64) in;
+#include "gpu/kernel_interface.h"
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer cells;    // rg32ui: depth in 0.1 mm, 3 int8 normals
 layout(binding = 1) uniform utextureBuffer members;  // rgba32ui, 4 texels per member
 layout(binding = 2) uniform utextureBuffer depth;    // r32ui: float metres, row-major
 layout(std430, binding = 3) buffer Scores { uvec4 scores[]; };  // 2 per member
-layout(push_constant) uniform Push {
-  float fx, fy, cx, cy;
-  int width, height;
-  uint member_count;
-  int normal_step;
-  float max_jump;
-  float depth_cap;
-} pc;
+layout(push_constant) uniform ScorePushBlock { ScorePush pc; };
 
 float sceneDepth(int x, int y) {
   if (x < 0 || y < 0 || x >= pc.width || y >= pc.height) return 0.0;
@@ -23,7 +17,8 @@ float sceneDepth(int x, int y) {
 }
 
 vec3 backProject(int u, int v, float d) {
-  return vec3((float(u) - pc.cx) * (1.0 / pc.fx) * d, (float(v) - pc.cy) * (1.0 / pc.fy) * d, d);
+  return vec3((float(u) - pc.camera.cx) * (1.0 / pc.camera.fx) * d, (float(v) - pc.camera.cy) * (1.0 / pc.camera.fy) * d,
+              d);
 }
 
 bool sceneNormal(int x, int y, out vec3 n) {

@@ -2,32 +2,34 @@
 // bins. The C++ twins live in src/match/border.hpp and src/match/*_reference.cpp.
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_samplerless_texture_functions : require
+#include "gpu/kernel_interface.h"
 
-// Sliding-window kernels take GROUP neighbouring outputs per invocation: neighbours share
+// The constants and push constants these kernels share with their hosts: kernel_interface.h.
+//
+// Sliding-window kernels take kPixelGroup neighbouring outputs per invocation: neighbours share
 // most of their inputs. On llvmpipe a load from a storage buffer at a per-invocation
 // offset, and a store, is a loop over the lanes (a texel fetch is a gather), so the feature
 // kernels read their inputs as texel buffers and take several pixels per load and store:
 // colour as packed BGRX words, labels 4 to a word. The loops over a group carry [[unroll]]:
 // their small arrays must be indexed by constants, an indexed local array being a loop
 // over the lanes too.
-const int GROUP = 4;  // kPixelGroup in frame_features_gpu.cpp
 
-// Invocation i's group of GROUP neighbouring pixels of one row of a width x height image:
+// Invocation i's group of kPixelGroup neighbouring pixels of one row of a width x height image:
 // row y, first column x0. False past the last group (the dispatch rounds up).
 bool rowGroup(int i, int width, int height, out int y, out int x0) {
-  int per_row = (width + GROUP - 1) / GROUP;
+  int per_row = (width + kPixelGroup - 1) / kPixelGroup;
   y = i / per_row;
-  x0 = (i - y * per_row) * GROUP;
+  x0 = (i - y * per_row) * kPixelGroup;
   return i < per_row * height;
 }
 
-// Invocation i's group of GROUP neighbouring rows of one column of a width x height image
+// Invocation i's group of kPixelGroup neighbouring rows of one column of a width x height image
 // (width counts elements: 3 per pixel for a colour image): first row y0, column x. False past
 // the last group.
 bool columnGroup(int i, int width, int height, out int y0, out int x) {
-  y0 = i / width * GROUP;
+  y0 = i / width * kPixelGroup;
   x = i - i / width * width;
-  return i < (height + GROUP - 1) / GROUP * width;
+  return i < (height + kPixelGroup - 1) / kPixelGroup * width;
 }
 
 // Colour pixels are packed BGRX words (byte 0 blue, 1 green, 2 red, 3 unused). Sums of them

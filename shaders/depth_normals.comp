@@ -3,10 +3,10 @@
 // centre by difference_threshold or more left out; binned into 8 image-plane directions.
 // Out: a packed label image (common.glsl), a word of 4 pixels per invocation.
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer depth;  // r16ui; a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
-layout(push_constant) uniform Push { int width; int height; int distance_threshold; int difference_threshold; } pc;
+layout(push_constant) uniform DepthNormalsPushBlock { DepthNormalsPush pc; };
 const int R = 5;
 uint normalLabel(int x, int y) {
   int i = y * pc.width + x;

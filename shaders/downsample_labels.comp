@@ -2,10 +2,10 @@
 // Nearest-neighbour halving of a label image: pixel (2x, 2y). In and out: packed label
 // images (common.glsl); a source word holds 2 of the 4 pixels of an output word.
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
-layout(push_constant) uniform Push { int src_width; int width; int height; } pc;
+layout(push_constant) uniform DownsampleLabelsPushBlock { DownsampleLabelsPush pc; };
 void main() {
   int y, x0;
   if (!rowWord(LINEAR_INVOCATION, pc.width, pc.height, y, x0)) return;

@@ -2,10 +2,10 @@
 // 5x5 median of label values, replicated border (OpenCV's medianBlur(5) on 8 bits). In and
 // out: packed label images (common.glsl).
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
-layout(push_constant) uniform Push { int width; int height; } pc;
+layout(push_constant) uniform SizePushBlock { SizePush pc; };
 // The 4 low bits of v, one per byte.
 uint bitsToBytes(uint v) { return (v & 1u) | ((v & 2u) << 7u) | ((v & 4u) << 14u) | ((v & 8u) << 21u); }
 

@@ -3,10 +3,10 @@
 // of its 3x3 neighbourhood agree (first bin wins ties). In: sobel_orientation's packed
 // bin | 8 if strong. Out: a packed label image (common.glsl) of 1 << bin, or 0.
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer bins;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Labels { uint labels[]; };
-layout(push_constant) uniform Push { int width; int height; } pc;
+layout(push_constant) uniform SizePushBlock { SizePush pc; };
 void main() {
   int i = LINEAR_INVOCATION;
   int y, x0;

@@ -8,7 +8,7 @@
 // 2026-11-28).
 #extension GL_EXT_shader_atomic_int64 : require
 #include "raster_common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(std430, binding = 3) buffer Raster { uint64_t raster[]; };
 void main() {
   uint f = gl_GlobalInvocationID.x;

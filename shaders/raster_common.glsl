@@ -2,22 +2,13 @@
 // does the same float operations in the same order (`precise` keeps the compiler from fusing
 // them), so the CPU reference renders the same pixels.
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#include "gpu/kernel_interface.h"
 
 layout(std430, binding = 0) readonly buffer Vertices { vec4 vertices[]; };
 layout(std430, binding = 1) readonly buffer Faces { uvec4 faces[]; };
 layout(std430, binding = 2) readonly buffer Poses { vec4 poses[]; };  // 3 rows (R | t) per view
 
-layout(push_constant) uniform Push {
-  float fx, fy, cx, cy;
-  int width, height;
-  uint face_count;
-  uint flags;  // 1: per-vertex normals, 2: per-vertex colours
-} pc;
-
-const float kSubpixel = 8.0;      // fixed point: 1/8 pixel
-const float kNearZ = 1e-3;        // metres: a triangle with a corner this near or nearer is clipped
-const float kClipZ = 2e-3;        // metres: ... at this depth (clipFace), so no corner lies near zero
-const float kGuardPx = 1048576.0; // screen coordinates beyond this are dropped
+layout(push_constant) uniform RasterPushBlock { RasterPush pc; };
 
 // Edge functions are exact integers. In 32 bits when the triangle spans less than
 // kNarrowExtent in x and y: every difference is then below 2^14 and every product below 2^28
@@ -58,8 +49,8 @@ float edgeFunction(bool wide, ivec2 a, ivec2 b, ivec2 p) {
 // the outputs mean nothing). Triangles and clipped faces round their corners alike.
 bool projectPoint(vec3 p, out float rz_out, out ivec2 s) {
   precise float rz = 1.0 / p.z;
-  precise float sx = pc.fx * (p.x * rz) + pc.cx;
-  precise float sy = pc.fy * (p.y * rz) + pc.cy;
+  precise float sx = pc.camera.fx * (p.x * rz) + pc.camera.cx;
+  precise float sy = pc.camera.fy * (p.y * rz) + pc.camera.cy;
   rz_out = rz;
   s = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
   return abs(sx) < kGuardPx && abs(sy) < kGuardPx;
@@ -126,7 +117,8 @@ vec3 edgesAt(Triangle t, int x, int y) {
 // snapping that decides coverage; clamped to the face's own depth range for grazing faces
 // whose plane is nearly parallel to the ray.
 float planeDepthAt(vec3 n, float n_p0, vec2 zrange, int x, int y) {
-  precise vec3 ray = vec3((float(x) - pc.cx) * (1.0 / pc.fx), (float(y) - pc.cy) * (1.0 / pc.fy), 1.0);
+  precise vec3 ray = vec3((float(x) - pc.camera.cx) * (1.0 / pc.camera.fx),
+                          (float(y) - pc.camera.cy) * (1.0 / pc.camera.fy), 1.0);
   precise float denom = dot(n, ray);
   precise float z = denom != 0.0 ? n_p0 * (1.0 / denom) : zrange.y;
   return clamp(z, zrange.x, zrange.y);

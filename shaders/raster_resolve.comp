@@ -3,7 +3,7 @@
 // vertex normals, or the face normal) facing the camera, and colour (interpolated vertex
 // colour, or grey shaded by a light at the camera).
 #include "raster_common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(std430, binding = 3) readonly buffer Raster { uint64_t raster[]; };
 layout(std430, binding = 4) readonly buffer Normals { vec4 normals[]; };
 layout(std430, binding = 5) readonly buffer Colours { uint colours[]; };
@@ -39,24 +39,25 @@ void main() {
     face_n = t.n;
   } else {
     // A clipped face (raster_depth.comp): weights from its corners in the camera frame.
-    precise vec3 point = vec3((float(x) - pc.cx) * (1.0 / pc.fx), (float(y) - pc.cy) * (1.0 / pc.fy), 1.0) * z;
+    precise vec3 point = vec3((float(x) - pc.camera.cx) * (1.0 / pc.camera.fx),
+                              (float(y) - pc.camera.cy) * (1.0 / pc.camera.fy), 1.0) * z;
     w = faceWeights(view, f, point, face_n);
   }
   uvec4 idx = faces[f];
   precise vec3 n;
-  if ((pc.flags & 1u) != 0u) {
+  if ((pc.flags & kRasterVertexNormals) != 0u) {
     precise vec3 m = w.x * normals[idx.x].xyz + w.y * normals[idx.y].xyz + w.z * normals[idx.z].xyz;
     vec4 r0 = poses[3u * view], r1 = poses[3u * view + 1u], r2 = poses[3u * view + 2u];
     n = vec3(dot(r0.xyz, m), dot(r1.xyz, m), dot(r2.xyz, m));
   } else {
     n = face_n;
   }
-  precise vec3 ray = vec3((float(x) - pc.cx) / pc.fx, (float(y) - pc.cy) / pc.fy, 1.0);
+  precise vec3 ray = vec3((float(x) - pc.camera.cx) / pc.camera.fx, (float(y) - pc.camera.cy) / pc.camera.fy, 1.0);
   precise float len2 = dot(n, n);
   if (len2 > 0.0) n = n * (1.0 / sqrt(len2));
   if (dot(n, ray) > 0.0) n = -n;
   vec3 bgr;
-  if ((pc.flags & 2u) != 0u) {
+  if ((pc.flags & kRasterVertexColours) != 0u) {
     precise vec3 c = w.x * unpackUnorm4x8(colours[idx.x]).xyz + w.y * unpackUnorm4x8(colours[idx.y]).xyz +
                      w.z * unpackUnorm4x8(colours[idx.z]).xyz;
     bgr = c;

@@ -7,10 +7,10 @@
 layout(local_size_x = 1) in;
 layout(std430, binding = 0) readonly buffer Candidates { uint count; };
 layout(std430, binding = 1) buffer State { REFINE_STATE };
-layout(push_constant) uniform Push { uint stage; uint unit_capacity; uint candidate_capacity; } pc;
+layout(push_constant) uniform ArgsPushBlock { ArgsPush pc; };
 uvec4 grid(uint invocations) {
-  uint n = (invocations + 63u) / 64u;
-  return uvec4(max(min(n, 32768u), 1u), (n + 32767u) / 32768u, 1u, 0u);
+  uint n = (invocations + kWorkgroupSize - 1u) / kWorkgroupSize;
+  return uvec4(max(min(n, kGridColumns), 1u), (n + kGridColumns - 1u) / kGridColumns, 1u, 0u);
 }
 void main() {
   if (pc.stage == 0u) {
@@ -20,7 +20,7 @@ void main() {
     candidate_groups = grid(end - first_candidate);
   } else {
     max_units = max(max_units, unit_count);
-    for (int span = 1; span <= MAX_SPAN; ++span)
+    for (int span = 1; span <= kMaxSpan; ++span)
       run_groups[span - 1] = grid(min(run_count[span - 1], runCapacity(pc.unit_capacity, span)));
   }
 }

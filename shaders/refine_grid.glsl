@@ -1,20 +1,14 @@
-// Refinement works on units: one template's responses at BAND consecutive finer-level rows
-// (padded rows BAND k .. BAND k + BAND - 1) and one block of 16 cells of those rows.
+// Refinement works on units: one template's responses at kUnitBand consecutive finer-level rows
+// (padded rows kUnitBand k .. kUnitBand k + kUnitBand - 1) and one block of 16 cells of those rows.
 // Candidates of a template near each other have heavily overlapping 16 x 16 windows; each
-// unit they cover is scored once, and each feature's offset is read once for the BAND rows.
+// unit they cover is scored once, and each feature's offset is read once for the kUnitBand rows.
 // The windows mark the padded columns they cover, per template and band (refine_mark.comp);
 // refine_units.comp then lays that band's blocks from its first marked column on (padded
 // columns shift + 16 k .. shift + 16 k + 15), so that a lone window is one block, not the
 // two that blocks fixed at multiples of 16 would cut it into. A chunk's units are bits of
-// a block mark array: per template, per band, `words_per_band` words of one bit per block.
-const int BAND = 4;  // match kUnitBand in similarity_gpu.cpp
-struct UnitGrid {
-  int T_coarse, T_fine;
-  int pad;             // finer layout's padding cells
-  int bands;           // bands of the finer layout's padded rows
-  int words_per_band;  // block mark words per band
-  int column_words;    // column mark words per band
-};
+// a block mark array: per template, per band, `words_per_band` words of one bit per block
+// (UnitGrid, kUnitBand and kMaxSpan: src/gpu/kernel_interface.h).
+#include "gpu/kernel_interface.h"
 
 int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
@@ -29,12 +23,11 @@ ivec2 windowStart(UnitGrid g, int r, int c) {
 // Bit of block k of band `band` of the chunk's template t.
 uint blockBit(UnitGrid g, int t, int band, int k) { return uint((t * g.bands + band) * g.words_per_band * 32 + k); }
 
-int bandOf(UnitGrid g, int row) { return (row + g.pad) / BAND; }
+int bandOf(UnitGrid g, int row) { return (row + g.pad) / kUnitBand; }
 
-// Runs of neighbouring units are scored together, up to MAX_SPAN units (refine_units.comp).
+// Runs of neighbouring units are scored together, up to kMaxSpan units (refine_units.comp).
 // Each length has its own list in the runs buffer: a run of `span` units takes `span` of
 // the `capacity` unit slots, so that list needs at most capacity / span entries.
-const int MAX_SPAN = 4;  // match kMaxSpan in similarity_gpu.cpp
 uint runCapacity(uint capacity, int span) { return capacity / uint(span); }
 uint runRegion(uint capacity, int span) {
   uint region = 0u;
@@ -49,5 +42,5 @@ uint runRegion(uint capacity, int span) {
   uint next_candidate;   /* first candidate of the next chunk */                          \
   uint first_candidate;  /* first candidate of this chunk */                              \
   uvec4 candidate_groups;          /* byte 16 */                                          \
-  uvec4 run_groups[MAX_SPAN];      /* byte 32: per run length */                          \
-  uint run_count[MAX_SPAN];        /* byte 32 + 16 MAX_SPAN */
+  uvec4 run_groups[kMaxSpan];      /* byte 32: per run length */                          \
+  uint run_count[kMaxSpan];        /* byte 32 + 16 kMaxSpan */

@@ -3,14 +3,14 @@
 // candidates cover, per template and band of the window: 16 bits, one or two atomicOr,
 // and the band's bit in the occupancy mask that refine_units.comp reads first.
 #include "refine_grid.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(std430, binding = 0) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(std430, binding = 1) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 2) buffer ColumnMarks { uint columns[]; };
 layout(std430, binding = 3) buffer Occupied { uint occupied[]; };  // a bit per template band
-layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;
+layout(push_constant) uniform ChunkPushBlock { ChunkPush pc; };
 void main() {
-  uint cand = first_candidate + gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
+  uint cand = first_candidate + gl_GlobalInvocationID.y * kGridColumns * kWorkgroupSize + gl_GlobalInvocationID.x;
   if (cand >= next_candidate) return;
   uvec4 item = items[cand];
   int t = int(item.x) - pc.template_base;

@@ -4,7 +4,7 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #include "packed_scores.glsl"
 #include "refine_grid.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer blocks;  // r32ui
 layout(binding = 1) uniform utextureBuffer bases;   // r32ui
 layout(binding = 2) uniform utextureBuffer scores;  // rgba32ui, two texels per unit row
@@ -12,7 +12,7 @@ layout(std430, binding = 3) readonly buffer Candidates { uint count; uint pad0; 
 layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
 layout(std430, binding = 5) writeonly buffer Results { uvec2 results[]; };
 layout(binding = 6) uniform utextureBuffer shifts;  // r32ui, per template band
-layout(push_constant) uniform Push { int template_base; UnitGrid grid; } pc;
+layout(push_constant) uniform ChunkPushBlock { ChunkPush pc; };
 
 uint unitIndex(uint bit) {
   int word = int(bit >> 5);
@@ -24,12 +24,12 @@ uint unitIndex(uint bit) {
 // two consecutive blocks (one if o == 0) of the row's band, whose blocks start at its shift.
 void windowRow(ivec2 start, int t, int row, out int o, out uvec4 lo0, out uvec4 hi0, out uvec4 lo1, out uvec4 hi1) {
   int band = bandOf(pc.grid, start.x + row);
-  int in_band = start.x + row + pc.grid.pad - band * BAND;
+  int in_band = start.x + row + pc.grid.pad - band * kUnitBand;
   int column = start.y + pc.grid.pad - int(texelFetch(shifts, t * pc.grid.bands + band).x);
   int k = column >> 4;
   o = column & 15;
-  int u0 = int(unitIndex(blockBit(pc.grid, t, band, k))) * BAND + in_band;
-  int u1 = o == 0 ? u0 : int(unitIndex(blockBit(pc.grid, t, band, k + 1))) * BAND + in_band;
+  int u0 = int(unitIndex(blockBit(pc.grid, t, band, k))) * kUnitBand + in_band;
+  int u1 = o == 0 ? u0 : int(unitIndex(blockBit(pc.grid, t, band, k + 1))) * kUnitBand + in_band;
   lo0 = texelFetch(scores, 2 * u0);
   hi0 = texelFetch(scores, 2 * u0 + 1);
   lo1 = texelFetch(scores, 2 * u1);
@@ -37,7 +37,7 @@ void windowRow(ivec2 start, int t, int row, out int o, out uvec4 lo0, out uvec4 
 }
 
 void main() {
-  uint cand = first_candidate + gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
+  uint cand = first_candidate + gl_GlobalInvocationID.y * kGridColumns * kWorkgroupSize + gl_GlobalInvocationID.x;
   if (cand >= next_candidate) return;
   uvec4 item = items[cand];
   int t = int(item.x) - pc.template_base;

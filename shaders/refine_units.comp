@@ -3,11 +3,11 @@
 // blocks of 16 columns from the band's first marked column on (its shift), a bit for each
 // block holding a marked column. Each non-zero block word gets a range of unit slots, where
 // similarity_refine.comp writes each unit's scores (the order across words does not
-// matter). Runs of consecutive blocks are cut into pieces of at most MAX_SPAN units and
+// matter). Runs of consecutive blocks are cut into pieces of at most kMaxSpan units and
 // listed by length: a piece of L units costs L + 1 texel fetches per row and feature, where
 // units one by one would cost 2 L.
 #include "refine_grid.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(std430, binding = 0) readonly buffer ColumnMarks { uint columns[]; };
 layout(std430, binding = 1) writeonly buffer BlockMarks { uint blocks[]; };
 layout(std430, binding = 2) writeonly buffer Bases { uint bases[]; };
@@ -15,9 +15,9 @@ layout(std430, binding = 3) writeonly buffer Shifts { uint shifts[]; };
 layout(std430, binding = 4) writeonly buffer Runs { uvec4 runs[]; };
 layout(std430, binding = 5) buffer State { REFINE_STATE };
 layout(std430, binding = 6) readonly buffer Occupied { uint occupied[]; };  // a bit per template band
-layout(push_constant) uniform Push { uint bands; uint capacity; UnitGrid grid; } pc;
+layout(push_constant) uniform UnitsPushBlock { UnitsPush pc; };
 void main() {
-  uint tb = gl_GlobalInvocationID.y * 32768u * 64u + gl_GlobalInvocationID.x;
+  uint tb = gl_GlobalInvocationID.y * kGridColumns * kWorkgroupSize + gl_GlobalInvocationID.x;
   if (tb >= pc.bands) return;
   // Most bands hold no window: one word tells, where the column words would take several.
   if ((occupied[tb >> 5] & (1u << (tb & 31u))) == 0u) return;
@@ -50,8 +50,8 @@ void main() {
       uint rest = m >> uint(b);
       int len = rest == 0xFFFFFFFFu ? 32 - b : findLSB(~rest);
       m &= len == 32 ? 0u : ~(((1u << uint(len)) - 1u) << uint(b));
-      for (int p = 0; p < len; p += MAX_SPAN) {
-        int span = min(MAX_SPAN, len - p);
+      for (int p = 0; p < len; p += kMaxSpan) {
+        int span = min(kMaxSpan, len - p);
         uint k = atomicAdd(run_count[span - 1], 1u);
         if (k < runCapacity(pc.capacity, span))
           runs[runRegion(pc.capacity, span) + k] =

@@ -8,14 +8,10 @@
 #include "common.glsl"
 const int BLOCKS = 2;  // of 8 cells, a word each
 const int CELLS = 8 * BLOCKS;
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer spread;  // packed (common.glsl); a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Memory { uvec2 memory[]; };
-layout(push_constant) uniform Push {
-  int width; int height; int T; int pad; int stride; int rows;
-  int outside;  // response of cells outside the image (MatchParams::outside_response), every bin
-  int modality;
-} pc;
+layout(push_constant) uniform LinearizePushBlock { LinearizePush pc; };
 void main() {
   int i = LINEAR_INVOCATION;
   // Aligned groups of CELLS padded cells that hold image cells (the stride, and so the plane

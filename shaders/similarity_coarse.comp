@@ -1,7 +1,7 @@
 #version 450
 // Stage 2, coarse level: every template (workgroup row y) at every cell position of its
 // range (match::coarseRange); positions over the template's raw threshold are
-// appended to the candidate list. An invocation scores ROWS rows of SPAN blocks of 16
+// appended to the candidate list. An invocation scores kCoarseRows rows of SPAN blocks of 16
 // positions: per row and feature TEXELS texels of 32 nibbles, where a lane per block would
 // fetch two each (the fetches are what the pass costs on llvmpipe).
 //
@@ -10,19 +10,12 @@
 // strip of positions has no anchor cell within the template's depth gate reads nothing, and
 // a passing position is appended only when its own anchor cell is within the gate.
 #include "similarity_common.glsl"
-layout(local_size_x = 16) in;  // kCoarseGroup in similarity_gpu.cpp
+layout(local_size_x = kCoarseWorkgroupSize) in;
 layout(std430, binding = 3) buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 // Anchor cells' depth intervals (least | greatest << 16, mm): plane 0 per cell, plane 1 + k
 // rows r and r + 1 over columns c .. c + 2^k - 1 (match::AnchorDepthCells).
 layout(binding = 4) uniform utextureBuffer depth_cells;
-layout(push_constant) uniform Push {
-  int template_base;  // global id of this chunk's first template
-  int stride;         // cells per linear-memory row (a multiple of 32)
-  uint capacity;      // candidate slots
-  int cells_x;        // anchor cells per row; 0: no pruning
-  int cells_y;
-  int boxes_at;       // the band boxes' first texel in depth_cells
-} pc;
+layout(push_constant) uniform CoarsePushBlock { CoarsePush pc; };
 
 uint depthCell(int plane, int r, int c) { return texelFetch(depth_cells, (plane * pc.cells_y + r) * pc.cells_x + c).x; }
 bool meets(uint interval, int z_lo, int z_hi) { return int(interval & 0xFFFFu) <= z_hi && int(interval >> 16u) >= z_lo; }
@@ -43,13 +36,12 @@ bool stripMayPass(int ra, int ca, int columns, int z_lo, int z_hi) {
   uint interval = min(a & 0xFFFFu, b & 0xFFFFu) | (max(a >> 16u, b >> 16u) << 16u);
   return meets(interval, z_lo, z_hi);
 }
-const int ROWS = 2;  // match kCoarseRows in similarity_gpu.cpp
-const int SPAN = 3;  // match kCoarseSpan in similarity_gpu.cpp
+const int SPAN = kCoarseSpan;  // ADD_ROW_BLOCKS reads SPAN
 const int TEXELS = TEXELS_FOR(16 * SPAN);
 void main() {
   int idx = int(gl_GlobalInvocationID.x);
   int t = int(gl_WorkGroupID.y);
-  int h = t * HEADER_INTS;
+  int h = t * kHeaderInts;
   // This template's own range of positions (match::coarseRange): first column and row,
   // columns, rows; with pruning, clipped to its depth band's box (match::clipToBox).
   int c_lo = headers[h + 2], r_lo = headers[h + 3], columns = headers[h + 5], rows = headers[h + 6];
@@ -66,10 +58,10 @@ void main() {
     if (rows == 0 || columns == 0) return;
   }
   int spans = (columns + 16 * SPAN - 1) / (16 * SPAN);
-  if (idx >= (rows + ROWS - 1) / ROWS * spans) return;
+  if (idx >= (rows + kCoarseRows - 1) / kCoarseRows * spans) return;
   int band = idx / spans;
   int span = idx - band * spans;
-  int r0 = r_lo + band * ROWS;
+  int r0 = r_lo + band * kCoarseRows;
   int c0 = c_lo + span * 16 * SPAN;
   int f = headers[h], end = f + headers[h + 1];
   // A strip that cannot pass reads no memory: no features to add (llvmpipe skips the loop
@@ -77,34 +69,34 @@ void main() {
   if (!stripMayPass(r0 + anchor_dr, c0 + anchor_dc, min(16 * SPAN, columns - span * 16 * SPAN), z_lo, z_hi)) end = f;
   uint base = uint(r0 * pc.stride + c0);
   int row_texels = pc.stride / 32;
-  uvec4 lo[ROWS * SPAN], hi[ROWS * SPAN];
-  for (int i = 0; i < ROWS * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
+  uvec4 lo[kCoarseRows * SPAN], hi[kCoarseRows * SPAN];
+  for (int i = 0; i < kCoarseRows * SPAN; ++i) lo[i] = hi[i] = uvec4(0u);
   while (f < end) {
-    int chunk_end = min(f + FEATURES_PER_8BIT, end);
-    uvec4 acc[ROWS * SPAN];
-    for (int i = 0; i < ROWS * SPAN; ++i) acc[i] = uvec4(0u);
+    int chunk_end = min(f + kFeaturesPer8Bit, end);
+    uvec4 acc[kCoarseRows * SPAN];
+    for (int i = 0; i < kCoarseRows * SPAN; ++i) acc[i] = uvec4(0u);
     for (; f < chunk_end; ++f) {
       // Nibble offset of the first position for this feature.
       int first;
       uint q, s;
       nibbleAddress(uint(texelFetch(feature_offsets, f).x) + base, first, q, s);
-      for (int r = 0; r < ROWS; ++r) ADD_ROW_BLOCKS(acc, r * SPAN, first + r * row_texels, q, s)
+      for (int r = 0; r < kCoarseRows; ++r) ADD_ROW_BLOCKS(acc, r * SPAN, first + r * row_texels, q, s)
     }
-    for (int i = 0; i < ROWS * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
+    for (int i = 0; i < kCoarseRows * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
   }
   uint threshold = uint(headers[h + 4]);
   // Few positions pass. llvmpipe runs both sides of every `if` under a lane mask, so the
   // appending below (an atomic is a loop over the lanes) would cost every invocation;
   // a loop whose count is 0 unless some position passes is skipped when no lane enters it.
   uint best = 0u;
-  for (int i = 0; i < ROWS * SPAN; ++i) best = max(best, maxOfSixteen(lo[i], hi[i]));
+  for (int i = 0; i < kCoarseRows * SPAN; ++i) best = max(best, maxOfSixteen(lo[i], hi[i]));
   for (uint any = best > threshold ? 1u : 0u; any > 0u; --any)
-  for (int r = 0; r < ROWS; ++r)
+  for (int r = 0; r < kCoarseRows; ++r)
     for (int k = 0; k < SPAN; ++k)
       for (int p = 0; p < 16; ++p) {
         uint score = scoreAt(lo[r * SPAN + k], hi[r * SPAN + k], p);
         int column = span * 16 * SPAN + k * 16 + p;
-        if (score > threshold && band * ROWS + r < rows && column < columns &&
+        if (score > threshold && band * kCoarseRows + r < rows && column < columns &&
             positionPasses(r0 + r + anchor_dr, c_lo + column + anchor_dc, z_lo, z_hi)) {
           uint slot = atomicAdd(count, 1u);
           if (slot < pc.capacity) items[slot] = uvec4(uint(pc.template_base + t), uint(r0 + r), uint(c_lo + column), score);

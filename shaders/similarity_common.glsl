@@ -7,6 +7,7 @@
 // memories (position (0, 0) of its grid plane). Up to 63 features add up in packed bytes,
 // then widen into packed 16-bit lanes (packed_scores.glsl).
 #extension GL_EXT_samplerless_texture_functions : require
+#include "gpu/kernel_interface.h"
 layout(binding = 0) uniform utextureBuffer memory;
 layout(binding = 2) uniform itextureBuffer feature_offsets;  // r32i
 
@@ -20,9 +21,6 @@ uvec4 nibbleBlock(uint a, uint b, uint c, uint s) {
   uvec2 w = s == 0u ? uvec2(a, b) : uvec2((a >> s) | (b << (32u - s)), (b >> s) | (c << (32u - s)));
   return uvec4(w & 0x0F0F0F0Fu, (w >> 4u) & 0x0F0F0F0Fu);
 }
-
-// Features whose byte sums add up before they widen (match::kFeaturesPer8Bit).
-const int FEATURES_PER_8BIT = 63;
 
 // Texels that hold `cells` consecutive cells starting at any of a texel's 32 nibbles.
 #define TEXELS_FOR(cells) (((cells) + 30) / 32 + 1)
@@ -70,4 +68,3 @@ void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
 // the depth gate (match::TemplateDepthGate: anchor cell column and row offsets, least and
 // greatest depth in mm), unused.
 layout(std430, binding = 1) readonly buffer Templates { int headers[]; };
-const int HEADER_INTS = 12;

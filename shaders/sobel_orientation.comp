@@ -5,11 +5,11 @@
 // of bin | 8 if strong; with write_magnitude, also the squared magnitude per pixel (training
 // ranks its feature candidates by it; frames bind a placeholder and skip the stores).
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer img;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Bins { uint bins[]; };
 layout(std430, binding = 2) writeonly buffer Magnitudes { int magnitude[]; };
-layout(push_constant) uniform Push { int width; int height; float threshold_sq; int write_magnitude; } pc;
+layout(push_constant) uniform SobelPushBlock { SobelPush pc; };
 void main() {
   int i = LINEAR_INVOCATION;
   int y, x0;

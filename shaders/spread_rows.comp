@@ -4,10 +4,10 @@
 // instead of T * T. In and out: packed label images (common.glsl); a word of 4 pixels per
 // invocation, whose windows span T + 3 pixels: T / 4 + 2 word loads at most.
 #include "common.glsl"
-layout(local_size_x = 64) in;
+layout(local_size_x = kWorkgroupSize) in;
 layout(binding = 0) uniform utextureBuffer src;  // a fetch is a gather on llvmpipe
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
-layout(push_constant) uniform Push { int width; int height; int T; } pc;
+layout(push_constant) uniform SpreadPushBlock { SpreadPush pc; };
 void main() {
   int y, x0;
   if (!rowWord(LINEAR_INVOCATION, pc.width, pc.height, y, x0)) return;

@@ -72,6 +72,23 @@ inline Pose compose(const Pose& a, const Pose& b) { return {a.R * b.R, a.R * b.t
 /// invert(a_T_b) = b_T_a.
 inline Pose invert(const Pose& p) { return {p.R.transpose(), -(p.R.transpose() * p.t)}; }
 
+/// Pinhole intrinsics rounded to float: what the GPU kernels take (push constants, e.g.
+/// gpu::ScorePush) and what their CPU twins compute with. One rounding of each double, so a
+/// kernel and its twin start from the same floats.
+struct FloatIntrinsics {
+  float fx = 0.f, fy = 0.f;  ///< focal lengths, pixels
+  float cx = 0.f, cy = 0.f;  ///< principal point, pixels
+
+  /// Pixel of camera-frame point p in float arithmetic, in this order: fx x / z + cx.
+  Eigen::Vector2f project(const Eigen::Vector3f& p) const { return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy}; }
+  /// The viewing ray through pixel (x, y) at depth 1 as the raster kernels compute it: times
+  /// the focal lengths' float reciprocals, which is not always the float that dividing by
+  /// them gives.
+  Eigen::Vector3f ray(int x, int y) const {
+    return {(static_cast<float>(x) - cx) * (1.0f / fx), (static_cast<float>(y) - cy) * (1.0f / fy), 1.0f};
+  }
+};
+
 struct Camera {
   double fx = 572.4114, fy = 573.57043;  ///< focal lengths, pixels (default: the LINEMOD Kinect)
   double cx = 325.2611, cy = 242.04899;  ///< principal point, pixels
@@ -80,6 +97,18 @@ struct Camera {
 
   Eigen::Vector2f project(const Eigen::Vector3f& p) const {
     return {static_cast<float>(fx * p.x() / p.z() + cx), static_cast<float>(fy * p.y() / p.z() + cy)};
+  }
+  /// The intrinsics rounded to float (for GPU kernels and their CPU twins).
+  FloatIntrinsics floatIntrinsics() const {
+    return {static_cast<float>(fx), static_cast<float>(fy), static_cast<float>(cx), static_cast<float>(cy)};
+  }
+  /// Pixels spanned along the image's x axis by a length of size_m metres facing the camera at
+  /// depth_m metres (float, in this order: size fx / depth): a projected diameter or radius.
+  float pixelsAcross(float size_m, float depth_m) const { return size_m * static_cast<float>(fx) / depth_m; }
+  /// Width and height, metres, that the whole image spans at depth depth_m (each image side
+  /// over its focal length computed in double, rounded to float once).
+  Eigen::Vector2f viewExtent(float depth_m) const {
+    return {depth_m * static_cast<float>(width / fx), depth_m * static_cast<float>(height / fy)};
   }
   /// The viewing ray through pixel (x, y): the camera-frame point at depth 1 there (computed
   /// in double, rounded to float once).

@@ -11,6 +11,7 @@
 
 #include "gpu/buffer.hpp"
 #include "gpu/kernel.hpp"
+#include "gpu/kernel_interface.h"
 
 namespace vkpose::gpu {
 
@@ -125,13 +126,14 @@ inline uint32_t groupsFor(std::size_t n, uint32_t size) {
   return static_cast<uint32_t>((n + size - 1) / size);
 }
 
-/// The same as a 2D grid of at most 32768 columns (item = (y * 32768 + x) * size + local).
+/// The same as a 2D grid of at most kGridColumns columns (item = (y * kGridColumns + x) * size +
+/// local), which the kernels dispatched so rely on.
 struct Groups2D {
   uint32_t x = 1, y = 1;
 };
 inline Groups2D groups2DFor(std::size_t n, uint32_t size) {
   const uint32_t g = groupsFor(n, size);
-  return {std::max<uint32_t>(std::min<uint32_t>(g, 32768u), 1u), (g + 32767u) / 32768u};
+  return {std::max<uint32_t>(std::min<uint32_t>(g, kGridColumns), 1u), (g + kGridColumns - 1u) / kGridColumns};
 }
 
 }  // namespace vkpose::gpu

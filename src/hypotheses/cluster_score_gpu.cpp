@@ -6,19 +6,11 @@
 #include <unordered_map>
 
 #include "gpu/batch.hpp"
+#include "gpu/kernel_interface.h"
 #include "hypotheses/cluster_score_math.hpp"
 
 namespace vkpose {
 namespace gpu {
-
-struct ScorePush {
-  float fx, fy, cx, cy;
-  int32_t width, height;
-  uint32_t member_count;
-  int32_t normal_step;
-  float max_jump;
-  float depth_cap;
-};
 
 class ClusterScoreKernels {
  public:
@@ -92,11 +84,9 @@ void ClusterScorer::scoreMembers(std::vector<Hypothesis>& hypotheses, const std:
   batch.upload(g.cells, cells.data(), cells.size() * 4);
   batch.upload(g.members, records.data(), records.size() * 4);
   batch.upload(g.depth, depth.data, depth.total() * 4);
-  const gpu::ScorePush push{static_cast<float>(scene.camera.fx), static_cast<float>(scene.camera.fy),
-                            static_cast<float>(scene.camera.cx), static_cast<float>(scene.camera.cy),
-                            depth.cols, depth.rows, static_cast<uint32_t>(member_count), params.normal_step_px,
-                            params.normal_max_jump_m, params.depth_cap_m};
-  const auto groups = gpu::groups2DFor(member_count, 64);
+  const gpu::ScorePush push{scene.camera.floatIntrinsics(), depth.cols, depth.rows, static_cast<uint32_t>(member_count),
+                            params.normal_step_px, params.normal_max_jump_m, params.depth_cap_m};
+  const auto groups = gpu::groups2DFor(member_count, gpu::kWorkgroupSize);
   batch.dispatch(g.kernel, {g.cells, g.members, g.depth, g.scores}, push, groups.x, groups.y);
   std::vector<uint32_t> out(member_count * 8);
   batch.download(g.scores, out.data(), out.size() * 4);

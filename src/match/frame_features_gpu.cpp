@@ -6,14 +6,13 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "gpu/kernel_interface.h"
 #include "match/match_geometry.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose::gpu {
 
 namespace {
-constexpr uint32_t kGroup = 64;
-constexpr std::size_t kPixelGroup = 4;  // GROUP in shaders/common.glsl
 // Zeros after the last plane, which the similarity kernels may read past (their values
 // never reach a score): the coarse pass fetches whole texels up to 64 bytes past a row's last
 // position, and refinement units cover 4 rows from a multiple of 4 (up to 3 rows past the
@@ -22,9 +21,6 @@ constexpr std::size_t kPixelGroup = 4;  // GROUP in shaders/common.glsl
 std::size_t memoryTailBytes(const LinearMemoryLayout& layout) { return 4 * static_cast<std::size_t>(layout.stride) + 64; }
 // A level's linear memory: a nibble per cell (the stride is a multiple of 32 cells).
 std::size_t memoryBytes(const LinearMemoryLayout& layout) { return layout.total_bytes() / 2 + memoryTailBytes(layout); }
-struct SizePush {
-  int32_t width, height;
-};
 }  // namespace
 
 struct FrameFeatures::Kernels {
@@ -35,15 +31,15 @@ struct FrameFeatures::Kernels {
   explicit Kernels(const GpuContext& c)
       : blur_rows(c, ShaderId::gaussian_blur7_rows, 2, sizeof(SizePush), {}, kWords),
         blur_cols(c, ShaderId::gaussian_blur7_cols, 2, sizeof(SizePush), {}, {{0, vk::Format::eR32G32Uint}}),
-        sobel(c, ShaderId::sobel_orientation, 3, 16, {}, kWords),
+        sobel(c, ShaderId::sobel_orientation, 3, sizeof(SobelPush), {}, kWords),
         vote(c, ShaderId::orientation_vote, 2, sizeof(SizePush), {}, kWords),
-        pyr_down(c, ShaderId::pyr_down, 2, 16, {}, kWords),
-        normals(c, ShaderId::depth_normals, 2, 16, {}, {{0, vk::Format::eR16Uint}}),
+        pyr_down(c, ShaderId::pyr_down, 2, sizeof(PyrDownPush), {}, kWords),
+        normals(c, ShaderId::depth_normals, 2, sizeof(DepthNormalsPush), {}, {{0, vk::Format::eR16Uint}}),
         median(c, ShaderId::median5, 2, sizeof(SizePush), {}, kWords),
-        downsample(c, ShaderId::downsample_labels, 2, 12, {}, kWords),
-        spread_rows(c, ShaderId::spread_rows, 2, 12, {}, kWords),
-        spread(c, ShaderId::spread, 2, 12, {}, kWords),
-        linearize(c, ShaderId::response_linearize, 2, 32, {}, kWords) {}
+        downsample(c, ShaderId::downsample_labels, 2, sizeof(DownsampleLabelsPush), {}, kWords),
+        spread_rows(c, ShaderId::spread_rows, 2, sizeof(SpreadPush), {}, kWords),
+        spread(c, ShaderId::spread, 2, sizeof(SpreadPush), {}, kWords),
+        linearize(c, ShaderId::response_linearize, 2, sizeof(LinearizePush), {}, kWords) {}
   Kernel blur_rows, blur_cols, sobel, vote, pyr_down, normals, median, downsample, spread_rows, spread, linearize;
 };
 
@@ -78,8 +74,8 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     Level& L = levels_[l];
     const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
     const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
-    const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
-    const uint32_t word_column_groups = groupsFor(words_per_row * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
+    const uint32_t word_groups = groupsFor(words_per_row * h, kWorkgroupSize);
+    const uint32_t word_column_groups = groupsFor(words_per_row * ((h + kPixelGroup - 1) / kPixelGroup), kWorkgroupSize);
     // Linear memories: padding cells are never written, so fill the buffer with the response
     // outside the image (a nibble per cell) only when its layout or that response changes.
     const LinearMemoryLayout& layout = layouts[l];
@@ -96,10 +92,10 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
     L.spread_rows.reserve(ctx_, label_bytes);
     for (int m = 0; m < kModalityCount; ++m) {
       if ((m == 0 && !params_.use_colour) || (m == 1 && !params_.use_depth)) continue;
-      const int32_t spush[3] = {L.size.width, L.size.height, layout.T};
+      const SpreadPush spush{L.size.width, L.size.height, layout.T};
       batch.dispatchLinear(k.spread_rows, {L.labels[m], L.spread_rows}, spush, word_groups);
       batch.dispatchLinear(k.spread, {L.spread_rows, L.spread}, spush, word_column_groups);
-      const int32_t lpush[8] = {L.size.width, L.size.height, layout.T,          layout.pad,
+      const LinearizePush lpush{L.size.width, L.size.height, layout.T,        layout.pad,
                                 layout.stride, layout.rows, outside_response, m};
       // One invocation per 16 aligned padded cells of a pixel row and grid column
       // (response_linearize.comp).
@@ -107,7 +103,7 @@ void FrameFeatures::record(Batch& batch, const LinemodFrame& frame, const std::v
       const auto cell_groups = static_cast<std::size_t>((layout.pad + cells_x + 15) / 16 - layout.pad / 16);
       batch.dispatchLinear(k.linearize, {L.spread, L.memory}, lpush,
                            groupsFor(static_cast<std::size_t>(L.size.height) * static_cast<std::size_t>(layout.T) * cell_groups,
-                                     kGroup));
+                                     kWorkgroupSize));
     }
   }
 }
@@ -123,14 +119,14 @@ void FrameFeatures::recordQuantization(Batch& batch, const LinemodFrame& frame, 
     const std::size_t n = static_cast<std::size_t>(L.size.area());
     const SizePush sp{L.size.width, L.size.height};
     // Sliding-window kernels take kPixelGroup neighbouring pixels of a row, or of a column,
-    // per invocation (GROUP in shaders/common.glsl).
+    // per invocation.
     const auto w = static_cast<std::size_t>(L.size.width), h = static_cast<std::size_t>(L.size.height);
-    const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kGroup);
-    const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kGroup);
+    const uint32_t row_groups = groupsFor(h * ((w + kPixelGroup - 1) / kPixelGroup), kWorkgroupSize);
+    const uint32_t column_groups = groupsFor(w * ((h + kPixelGroup - 1) / kPixelGroup), kWorkgroupSize);
     // Label images are packed 4 pixels per word, rows padded to whole words (wordsPerRow in
     // shaders/common.glsl); their kernels take a word per invocation.
     const std::size_t words_per_row = (w + 3) / 4, label_bytes = 4 * words_per_row * h;
-    const uint32_t word_groups = groupsFor(words_per_row * h, kGroup);
+    const uint32_t word_groups = groupsFor(words_per_row * h, kWorkgroupSize);
 
     if (params_.use_colour) {
       // Colour pixels are packed BGRX words on the device (shaders/common.glsl): a word load
@@ -142,7 +138,7 @@ void FrameFeatures::recordQuantization(Batch& batch, const LinemodFrame& frame, 
         cv::cvtColor(frame.bgr, bgrx, cv::COLOR_BGR2BGRA);
       } else {
         const Level& P = levels_[l - 1];
-        const int32_t push[4] = {P.size.width, P.size.height, L.size.width, L.size.height};
+        const PyrDownPush push{P.size.width, P.size.height, L.size.width, L.size.height};
         batch.dispatchLinear(k.pyr_down, {P.bgr, L.bgr}, push, row_groups);
       }
       L.blur_rows.reserve(ctx_, n * 8);
@@ -153,11 +149,8 @@ void FrameFeatures::recordQuantization(Batch& batch, const LinemodFrame& frame, 
       L.magnitude.reserve(ctx_, magnitudes ? n * 4 : 4);
       batch.dispatchLinear(k.blur_rows, {L.bgr, L.blur_rows}, sp, row_groups);
       batch.dispatchLinear(k.blur_cols, {L.blur_rows, L.smoothed}, sp, column_groups);
-      struct {
-        int32_t width, height;
-        float threshold_sq;
-        int32_t write_magnitude;
-      } sobel_push{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold, magnitudes ? 1 : 0};
+      const SobelPush sobel_push{L.size.width, L.size.height, params_.weak_threshold * params_.weak_threshold,
+                                 magnitudes ? 1 : 0};
       batch.dispatchLinear(k.sobel, {L.smoothed, L.raw_bins, L.magnitude}, sobel_push, word_groups);
       batch.dispatchLinear(k.vote, {L.raw_bins, L.labels[0]}, sp, word_groups);
     }
@@ -168,13 +161,13 @@ void FrameFeatures::recordQuantization(Batch& batch, const LinemodFrame& frame, 
         L.depth_raw.reserve(ctx_, label_bytes);
         cv::Mat depth = frame.depth_mm.isContinuous() ? frame.depth_mm : frame.depth_mm.clone();
         batch.upload(depth_, depth.data, n * 2);
-        const int32_t push[4] = {L.size.width, L.size.height, params_.distance_threshold_mm,
-                                 params_.difference_threshold_mm};
+        const DepthNormalsPush push{L.size.width, L.size.height, params_.distance_threshold_mm,
+                                    params_.difference_threshold_mm};
         batch.dispatchLinear(k.normals, {depth_, L.depth_raw}, push, word_groups);
         batch.dispatchLinear(k.median, {L.depth_raw, L.labels[1]}, sp, word_groups);
       } else {
         const Level& P = levels_[l - 1];
-        const int32_t push[3] = {P.size.width, L.size.width, L.size.height};
+        const DownsampleLabelsPush push{P.size.width, L.size.width, L.size.height};
         batch.dispatchLinear(k.downsample, {P.labels[1], L.labels[1]}, push, word_groups);
       }
     }

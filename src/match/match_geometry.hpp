@@ -12,8 +12,6 @@ namespace vkpose::match {
 /// Half of the refinement window, in cells: LINEMOD refines in a 16 x 16 cell window.
 constexpr int kRefineHalf = 8;
 constexpr int kRefineWindow = 2 * kRefineHalf;
-/// Features summed in 8 bits before widening to 16 (63 * 4 = 252 < 256).
-constexpr int kFeaturesPer8Bit = 63;
 
 /// Reported position of cell c at spreading step T: the one-sided T x T spreading window
 /// means a template at cell c covers pixels c*T .. c*T+T-1; OpenCV reports c*T + this.

@@ -2,29 +2,20 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 
+#include "gpu/kernel_interface.h"
 #include "match/frame_features_gpu.hpp"
 #include "vkpose/error.hpp"
 
 namespace vkpose::gpu {
 
 namespace {
-constexpr int kHeaderInts = 12;  // HEADER_INTS in shaders/similarity_common.glsl
-constexpr uint32_t kGroup = 64;
-constexpr int kCoarseRows = 2;  // rows per coarse invocation: ROWS in shaders/similarity_coarse.comp
-constexpr int kCoarseSpan = 3;  // blocks of 16 positions per coarse invocation: SPAN there
+// The kernels' constants and push constants (kUnitBand, kMaxSpan, UnitGrid, CoarsePush, ...)
+// are gpu/kernel_interface.h's, shared with the shaders.
 static_assert(kCoarseRows == match::kStripRows && 16 * kCoarseSpan == match::kStripColumns,
               "depth pruning skips what one coarse invocation scores");
-// Coarse workgroup size (local_size_x there): a template needs about 15 invocations at 640 x
-// 480, and on llvmpipe each idle 8-lane vector of a workgroup still costs a pass through
-// the shader, so 64 would spend most of the time on empty lanes.
-constexpr uint32_t kCoarseGroup = 16;
-constexpr int kUnitBand = 4;  // rows per unit: BAND in shaders/refine_grid.glsl
 constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
-// Longest run of neighbouring units one refinement invocation scores: MAX_SPAN in
-// shaders/refine_grid.glsl. Runs of each length are listed apart and scored by a kernel
-// specialized for that length.
-constexpr uint32_t kMaxSpan = 4;
 // State buffer (REFINE_STATE in refine_grid.glsl): unit count, most units of a chunk, next
 // and this chunk's first candidate, the indirect dispatch sizes over the chunk's candidates
 // and over its runs of each length, then the run counts.
@@ -37,32 +28,6 @@ std::size_t runListEntries(uint32_t unit_capacity) {
   for (uint32_t span = 1; span <= kMaxSpan; ++span) entries += unit_capacity / span;
   return entries;
 }
-
-struct UnitGrid {
-  int32_t T_coarse = 0, T_fine = 0, pad = 0, bands = 0, words_per_band = 0, column_words = 0;
-};
-struct CoarsePush {
-  int32_t template_base, stride;
-  uint32_t capacity;
-  int32_t depth_cells_x, depth_cells_y;  // 0: no pruning
-  int32_t depth_boxes_at;
-};
-struct UnitsPush {
-  uint32_t bands, capacity;  // template bands of the chunk, unit slots
-  UnitGrid grid;
-};
-struct ArgsPush {
-  uint32_t stage, unit_capacity, candidate_capacity;
-};
-struct RefinePush {
-  int32_t stride;
-  uint32_t capacity;
-  UnitGrid grid;
-};
-struct ChunkPush {  // refine_mark, refine_select
-  int32_t template_base;
-  UnitGrid grid;
-};
 
 // Blocks of a band (refine_grid.glsl): from the band's first marked column on, at most
 // stride / 16 of them, as the stride is a multiple of 16.
@@ -153,9 +118,11 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
         const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response)
                                            : match::CoarseRange{};
         const match::TemplateDepthGate gate = gates.empty() ? match::TemplateDepthGate{} : gates[t];
-        headers[l].insert(headers[l].end(), {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
-                                             threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
-                                             gate.z_lo_mm, gate.z_hi_mm, gate.band});
+        const int32_t header[] = {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
+                                  threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
+                                  gate.z_lo_mm, gate.z_hi_mm, gate.band};
+        static_assert(std::size(header) == kHeaderInts, "similarity_common.glsl reads kHeaderInts ints a template");
+        headers[l].insert(headers[l].end(), std::begin(header), std::end(header));
         if (l + 1 == levels) {
           ranges_[t] = range;
           chunk.coarse_invocations = std::max<std::size_t>(
@@ -217,7 +184,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
   state_.reserve(ctx_, kStateBytes, MemoryKind::HostVisible);
   batch.fill(candidates_, 0u, 16);
   batch.fill(state_, 0u, kStateBytes);
-  UnitGrid grid;
+  UnitGrid grid{};  // all 0 without refinement
   if (refine) {
     grid = unitGrid(cl, layouts_[0]);
     columns_.reserve(ctx_, column_words_ * 4);
@@ -236,7 +203,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
     if (chunk.coarse_invocations > 0)
       batch.dispatch(kernels_->coarse,
                      {features.memory(coarse), chunk.headers[coarse], chunk.offsets[coarse], candidates_, depth_}, push,
-                     groupsFor(chunk.coarse_invocations, kCoarseGroup), static_cast<uint32_t>(chunk.template_count));
+                     groupsFor(chunk.coarse_invocations, kCoarseWorkgroupSize), static_cast<uint32_t>(chunk.template_count));
     if (!refine) continue;
     const ChunkPush chunk_push{chunk.first_template, grid};
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{0, unit_capacity_, capacity_}, 1);
@@ -246,7 +213,7 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
                            kCandidateArgs);
     batch.fill(state_, 0u, 4);                          // this chunk's unit count
     batch.fill(state_, 0u, 4 * kMaxSpan, kRunCounts);  // and run counts
-    const auto g = groups2DFor(bands, kGroup);
+    const auto g = groups2DFor(bands, kWorkgroupSize);
     batch.dispatch(kernels_->units, {columns_, blocks_, bases_, shifts_, runs_, state_, occupied_},
                    UnitsPush{static_cast<uint32_t>(bands), unit_capacity_, grid}, g.x, g.y);
     batch.dispatch(kernels_->args, {candidates_, state_}, ArgsPush{1, unit_capacity_, capacity_}, 1);

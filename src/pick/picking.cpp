@@ -225,7 +225,7 @@ SceneClearance sceneClearance(const SweptGripper& swept, const Pose& camera_T_gr
   const float r = radius + clearance;
   if (c.z() - r <= 0.01f) return out;  // reaches the camera: the window would be the whole image
   const Eigen::Vector2f px = camera.project(c);
-  const float pr = static_cast<float>(camera.fx) * r / (c.z() - r);
+  const float pr = camera.pixelsAcross(r, c.z() - r);
   const int u0 = std::max(0, static_cast<int>(px.x() - pr)), u1 = std::min(depth_m.cols - 1, static_cast<int>(px.x() + pr));
   const int v0 = std::max(0, static_cast<int>(px.y() - pr)), v1 = std::min(depth_m.rows - 1, static_cast<int>(px.y() + pr));
   for (int v = v0; v <= v1; v += 2)

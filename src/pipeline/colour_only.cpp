@@ -93,7 +93,7 @@ std::string implausibleFit(const PoseCandidate& c, const Pose& pose, const Templ
     return fmt::format("the fit moved it to {:.2f} m, outside the trained distances ({:.2f}-{:.2f} m)", centre.z(),
                        bank.params.views.radii.from, bank.params.views.radii.to);
   const Eigen::Vector2f at = camera.project(centre);
-  const float diameter_px = bank.diameter * static_cast<float>(camera.fx) / centre.z();
+  const float diameter_px = camera.pixelsAcross(bank.diameter, centre.z());
   if ((at - Eigen::Vector2f(c.detection.x, c.detection.y)).norm() > 0.5f * diameter_px)
     return "the fit slid off its hypothesis's place";
   return {};
@@ -221,7 +221,7 @@ static void acceptByContour(std::vector<PoseCandidate>& candidates, const std::v
     }
     const TemplateBank& bank = banks[c.bank()];
     const Eigen::Vector3f centre = d.pose.R * bank.centre + d.pose.t;
-    const Place place{camera.project(centre), 0.5f * bank.diameter * static_cast<float>(camera.fx) / centre.z()};
+    const Place place{camera.project(centre), camera.pixelsAcross(0.5f * bank.diameter, centre.z())};
     const bool duplicate = std::any_of(taken.begin(), taken.end(), [&](const Place& p) {
       return (p.at - place.at).norm() < std::min(p.radius, place.radius);
     });

@@ -182,13 +182,13 @@ Cost evaluate(const std::vector<ContourPoint>& points, const Pose& pose, const C
   Cost cost;
   if (H) H->setZero(), g->setZero();
   const double cap2 = static_cast<double>(cap) * cap;
+  const FloatIntrinsics k = cam.floatIntrinsics();
   for (const ContourPoint& pt : points) {
     const Eigen::Vector3f p = pose.R * pt.model + pose.t;
     if (!(p.z() > 1e-3f)) continue;
-    const float u = static_cast<float>(cam.fx) * p.x() / p.z() + static_cast<float>(cam.cx);
-    const float v = static_cast<float>(cam.fy) * p.y() / p.z() + static_cast<float>(cam.cy);
+    const Eigen::Vector2f uv = k.project(p);
     float d, gu, gv;
-    if (!sampleDistance(maps.distance[pt.bin], u, v, d, gu, gv)) continue;  // off the image: no evidence
+    if (!sampleDistance(maps.distance[pt.bin], uv.x(), uv.y(), d, gu, gv)) continue;  // off the image: no evidence
     ++cost.n;
     if (d >= cap) {
       cost.sum += cap2;
@@ -198,8 +198,7 @@ Cost evaluate(const std::vector<ContourPoint>& points, const Pose& pose, const C
     cost.sum += static_cast<double>(d) * d;
     if (!H) continue;
     const float iz = 1.f / p.z();
-    const Eigen::Vector3f jp(gu * static_cast<float>(cam.fx) * iz, gv * static_cast<float>(cam.fy) * iz,
-                             -(gu * static_cast<float>(cam.fx) * p.x() + gv * static_cast<float>(cam.fy) * p.y()) * iz * iz);
+    const Eigen::Vector3f jp(gu * k.fx * iz, gv * k.fy * iz, -(gu * k.fx * p.x() + gv * k.fy * p.y()) * iz * iz);
     Eigen::Matrix<double, 6, 1> J;
     J.head<3>() = jp.cast<double>();
     J.tail<3>() = p.cross(jp).cast<double>();  // d(p)/d(omega) = -[p]x: jp . (omega x p) = omega . (p x jp)

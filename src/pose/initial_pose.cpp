@@ -149,8 +149,9 @@ cv::Rect projectedWindow(const Pose& pose, const Eigen::Vector3f& centre, float 
   // projected centre (the projection of its nearest cross-section bounds it).
   const Eigen::Vector2f uv = camera.project(c);
   const float scale = radius / (c.z() - radius);
-  const float rx = static_cast<float>(camera.fx) * scale * (1.f + std::abs(c.x()) / c.z()) + static_cast<float>(margin_px);
-  const float ry = static_cast<float>(camera.fy) * scale * (1.f + std::abs(c.y()) / c.z()) + static_cast<float>(margin_px);
+  const FloatIntrinsics k = camera.floatIntrinsics();
+  const float rx = k.fx * scale * (1.f + std::abs(c.x()) / c.z()) + static_cast<float>(margin_px);
+  const float ry = k.fy * scale * (1.f + std::abs(c.y()) / c.z()) + static_cast<float>(margin_px);
   const float x0 = std::max(uv.x() - rx, -1.f), y0 = std::max(uv.y() - ry, -1.f);
   const float x1 = std::min(uv.x() + rx, static_cast<float>(camera.width) + 1.f),
               y1 = std::min(uv.y() + ry, static_cast<float>(camera.height) + 1.f);

@@ -6,15 +6,17 @@
 #include <cmath>
 #include <cstdint>
 
+#include "gpu/kernel_interface.h"
 #include "render/render.hpp"
 #include "vkpose/geometry.hpp"
 
 namespace vkpose::render {
 
-constexpr float kSubpixel = 8.0f;
-constexpr float kNearZ = 1e-3f;  ///< a triangle with a corner this near or nearer is clipped
-constexpr float kClipZ = 2e-3f;  ///< ... at this depth (clipFace)
-constexpr float kGuardPx = 1048576.0f;
+// The kernels' own constants (fixed point, near and clip planes, guard band).
+using gpu::kClipZ;
+using gpu::kGuardPx;
+using gpu::kNearZ;
+using gpu::kSubpixel;
 
 struct Fixed2 {
   int64_t x = 0, y = 0;
@@ -31,18 +33,11 @@ struct Triangle {
   float z_near = 0.f, z_far = 0.f;
 };
 
-/// The shader's camera constants, as floats.
-struct ScreenParams {
-  float fx, fy, cx, cy;
+/// The shader's camera constants (gpu::RasterPush): float intrinsics, whose ray() is the
+/// raster kernels' viewing ray, and the image size.
+struct ScreenParams : FloatIntrinsics {
   int width, height;
-  explicit ScreenParams(const Camera& c)
-      : fx(static_cast<float>(c.fx)), fy(static_cast<float>(c.fy)), cx(static_cast<float>(c.cx)),
-        cy(static_cast<float>(c.cy)), width(c.width), height(c.height) {}
-  /// The viewing ray through pixel (x, y) at depth 1, as the raster kernels compute it (the
-  /// focal lengths' float reciprocals).
-  Eigen::Vector3f ray(int x, int y) const {
-    return {(static_cast<float>(x) - cx) * (1.0f / fx), (static_cast<float>(y) - cy) * (1.0f / fy), 1.0f};
-  }
+  explicit ScreenParams(const Camera& c) : FloatIntrinsics(c.floatIntrinsics()), width(c.width), height(c.height) {}
 };
 
 inline Eigen::Vector3f toCamera(const Pose& pose, const Eigen::Vector3f& v) {

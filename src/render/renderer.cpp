@@ -156,11 +156,7 @@ Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy)
 // ---- GPU --------------------------------------------------------------------------------
 
 namespace {
-struct RasterPush {
-  float fx, fy, cx, cy;
-  int32_t width, height;
-  uint32_t face_count, flags;
-};
+using gpu::RasterPush;
 constexpr std::size_t kBatchBytes = 96u << 20;  // per-batch output budget
 
 /// lavapipe (llvmpipe's gallivm) ends an invocation's loops after 65,535 iterations counted
@@ -199,7 +195,8 @@ struct MeshRenderer::Impl {
     face_count = static_cast<uint32_t>(mesh.faces.size());
     centre = mesh.bboxCentre();
     for (const auto& v : mesh.vertices) radius = std::max(radius, (v - centre).norm());
-    flags = (mesh.normals.empty() ? 0u : 1u) | (mesh.colours.empty() ? 0u : 2u);
+    flags = (mesh.normals.empty() ? 0u : gpu::kRasterVertexNormals) |
+            (mesh.colours.empty() ? 0u : gpu::kRasterVertexColours);
     std::vector<float> v4;
     for (const auto& v : mesh.vertices) v4.insert(v4.end(), {v.x(), v.y(), v.z(), 0.f});
     std::vector<uint32_t> f4;
@@ -267,8 +264,8 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
   if (pixels * 16 > m.ctx.device().max_storage_buffer_range)
     throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
   const std::size_t per_batch = viewsPerBatch(camera);
-  const RasterPush push{static_cast<float>(camera.fx), static_cast<float>(camera.fy), static_cast<float>(camera.cx),
-                        static_cast<float>(camera.cy), camera.width, camera.height, m.face_count, m.flags};
+  const RasterPush push{camera.floatIntrinsics(), camera.width, camera.height, m.face_count, m.flags};
+  const uint32_t face_groups = gpu::groupsFor(m.face_count, gpu::kWorkgroupSize);
   std::vector<Rendering> out;
   out.reserve(poses.size());
   std::vector<float> depth, normals;
@@ -290,14 +287,14 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     gpu::Batch& batch = m.batch;
     batch.upload(w.poses, rows.data(), rows.size() * 4);
     batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
-    batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
+    batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, face_groups,
                    static_cast<uint32_t>(n), rasterBands(camera));
     if (m.reachesPastTheCamera(poses, first, n))
-      batch.dispatch(m.clipped, {m.vertices, m.faces, w.poses, w.keys}, push, gpu::groupsFor(m.face_count, 64),
+      batch.dispatch(m.clipped, {m.vertices, m.faces, w.poses, w.keys}, push, face_groups,
                      static_cast<uint32_t>(n), rasterBands(camera));
     batch.dispatch(m.resolve,
                    {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
-                   push, gpu::groupsFor(pixels, 64), static_cast<uint32_t>(n));
+                   push, gpu::groupsFor(pixels, gpu::kWorkgroupSize), static_cast<uint32_t>(n));
     batch.download(w.depth, depth.data(), n * pixels * 4);
     batch.download(w.normal_out, normals.data(), n * pixels * 16);
     batch.download(w.colour_out, colour.data(), n * pixels * 4);

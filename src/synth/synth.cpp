@@ -328,8 +328,7 @@ RenderedImage renderImage(const GpuContext& ctx, const SynthParams& p, const std
 PlacementParams fitBinToParts(const PlacementParams& placement, float diameter, const Camera& camera,
                               const CameraRange& range) {
   const float nearest = range.max_distance_m > 0.f ? range.min_distance_m : range.min_height_m;
-  const Eigen::Vector2f view(nearest * static_cast<float>(camera.width / camera.fx),
-                             nearest * static_cast<float>(camera.height / camera.fy));
+  const Eigen::Vector2f view = camera.viewExtent(nearest);
   PlacementParams out = placement;
   for (int i = 0; i < 2; ++i)
     out.bin_inner_m[i] = std::min(placement.bin_inner_m[i], std::max(4.f * diameter, 0.7f * view[i]));
