@@ -11,8 +11,9 @@ namespace vkpose {
 
 void validateCamera(const Camera& c, const std::string& source) {
   auto bad = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", source, what)); };
-  if (!(std::isfinite(c.fx) && std::isfinite(c.fy) && c.fx > 0 && c.fy > 0))
-    bad(fmt::format("focal lengths must be positive (fx {}, fy {})", c.fx, c.fy));
+  const double fx = c.fx, fy = c.fy;
+  if (!(std::isfinite(fx) && std::isfinite(fy) && fx > 0 && fy > 0))
+    bad(fmt::format("focal lengths must be positive (fx {}, fy {})", fx, fy));
   if (!(std::isfinite(c.cx) && std::isfinite(c.cy))) bad("the principal point is not finite");
   if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
     bad(fmt::format("image size {}x{} is outside 1..16384", c.width, c.height));

@@ -36,11 +36,12 @@ inline float sceneDepth(const cv::Mat& depth_m, int x, int y) {
 /// `step` pixels either side, turned towards the camera. False at depth edges, holes and the
 /// image border.
 /// The camera-frame point at pixel (u, v) with depth d, in the float arithmetic of the cluster
-/// score kernel (cluster_score.comp): float intrinsics, the focal lengths' reciprocals.
+/// score kernel (cluster_score.comp): float intrinsics, the reciprocal of the float focal
+/// length taken in float as the kernel does (the reciprocal of the double one, rounded, is
+/// another float for about a quarter of focal lengths, the LINEMOD Kinect's among them).
 inline Eigen::Vector3f backProject(const ScoreScene& s, int u, int v, float d) {
-  const float ifx = static_cast<float>(1.0 / s.camera.fx), ify = static_cast<float>(1.0 / s.camera.fy);
-  const float cx = static_cast<float>(s.camera.cx), cy = static_cast<float>(s.camera.cy);
-  return {(static_cast<float>(u) - cx) * ifx * d, (static_cast<float>(v) - cy) * ify * d, d};
+  const Eigen::Vector3f r = s.camera.floatIntrinsics().ray(u, v);
+  return {r.x() * d, r.y() * d, d};
 }
 
 inline bool sceneNormal(const ScoreScene& s, int x, int y, int step, float max_jump, Eigen::Vector3f& n) {

@@ -35,6 +35,36 @@ UnitGrid unitGrid(const LinearMemoryLayout& coarse, const LinearMemoryLayout& fi
   return {coarse.T, fine.T, fine.pad, (fine.rows + kUnitBand - 1) / kUnitBand,
           (fine.stride / match::kRefineWindow + 31) / 32, (fine.stride + 31) / 32};
 }
+
+/// Appends a template's header (kHeaderInts ints) and feature offsets of each level to those
+/// of its chunk; returns its coarse range (only the coarse level, the last, scans a range;
+/// the finer one scores the units of refinement).
+match::CoarseRange appendTemplate(const LinemodTemplate& tmpl, const std::vector<LinearMemoryLayout>& layouts,
+                                  const MatchParams& params, const match::TemplateDepthGate& gate,
+                                  std::vector<int32_t> (&headers)[2], std::vector<int32_t> (&offsets)[2]) {
+  const std::size_t levels = layouts.size();
+  match::CoarseRange coarse;
+  for (std::size_t l = 0; l < levels; ++l) {
+    const auto& level = tmpl.levels[l];
+    const auto& layout = layouts[l];
+    const int n = static_cast<int>(level.features.size());
+    const int threshold = match::rawThreshold(n, params.threshold);
+    const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response)
+                                       : match::CoarseRange{};
+    const int32_t header[] = {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
+                              threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
+                              gate.z_lo_mm, gate.z_hi_mm, gate.band};
+    static_assert(std::size(header) == kHeaderInts, "similarity_common.glsl reads kHeaderInts ints a template");
+    headers[l].insert(headers[l].end(), std::begin(header), std::end(header));
+    if (l + 1 == levels) coarse = range;
+    const int T = layout.T;
+    for (const auto& f : level.features)
+      offsets[l].push_back(static_cast<int32_t>(
+          layout.offset(static_cast<int>(f.modality), f.bin, f.y % T, f.x % T, f.y / T, f.x / T)));
+  }
+  return coarse;
+}
+
 }  // namespace
 
 struct Similarity::Kernels {
@@ -109,32 +139,14 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
       std::size_t add = 0;
       for (const auto& level : templates[t].levels) add += level.features.size() * 4;
       if (chunk.template_count > 0 && (offsets[0].size() + offsets[1].size()) * 4 + add > max_bytes) break;
-      for (std::size_t l = 0; l < levels; ++l) {
-        const auto& level = templates[t].levels[l];
-        const auto& layout = layouts[l];
-        const int n = static_cast<int>(level.features.size());
-        const int threshold = match::rawThreshold(n, params.threshold);
-        // Only the coarse level scans a range; the finer one scores the units of refinement.
-        const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response)
-                                           : match::CoarseRange{};
-        const match::TemplateDepthGate gate = gates.empty() ? match::TemplateDepthGate{} : gates[t];
-        const int32_t header[] = {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
-                                  threshold, range.columns, range.rows, gate.anchor_dc, gate.anchor_dr,
-                                  gate.z_lo_mm, gate.z_hi_mm, gate.band};
-        static_assert(std::size(header) == kHeaderInts, "similarity_common.glsl reads kHeaderInts ints a template");
-        headers[l].insert(headers[l].end(), std::begin(header), std::end(header));
-        if (l + 1 == levels) {
-          ranges_[t] = range;
-          chunk.coarse_invocations = std::max<std::size_t>(
-              chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
-                                            static_cast<std::size_t>((range.columns + 16 * kCoarseSpan - 1) /
-                                                                     (16 * kCoarseSpan)));
-        }
-        const int T = layout.T;
-        for (const auto& f : level.features)
-          offsets[l].push_back(static_cast<int32_t>(
-              layout.offset(static_cast<int>(f.modality), f.bin, f.y % T, f.x % T, f.y / T, f.x / T)));
-      }
+      const match::CoarseRange range =
+          appendTemplate(templates[t], layouts, params, gates.empty() ? match::TemplateDepthGate{} : gates[t], headers,
+                         offsets);
+      ranges_[t] = range;
+      chunk.coarse_invocations = std::max<std::size_t>(
+          chunk.coarse_invocations, static_cast<std::size_t>((range.rows + kCoarseRows - 1) / kCoarseRows) *
+                                        static_cast<std::size_t>((range.columns + 16 * kCoarseSpan - 1) /
+                                                                 (16 * kCoarseSpan)));
       ++chunk.template_count;
       ++t;
     }
