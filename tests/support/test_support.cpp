@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <random>
@@ -15,7 +16,12 @@
 
 namespace vkpose::test {
 
-std::string sharedData() { return VKPOSE_SHARED_DATA_DIR; }
+// VKPOSE_TEST_SHARED_DATA overrides the compiled-in folder, so that a run with the data on
+// disk can still play a newcomer without it (VKPOSE_TEST_SHARED_DATA=/nonexistent).
+std::string sharedData() {
+  if (const char* dir = std::getenv("VKPOSE_TEST_SHARED_DATA"); dir && *dir) return dir;
+  return VKPOSE_SHARED_DATA_DIR;
+}
 
 TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params) {
   return loadOrTrainBank(context(), mesh, params, sampleViews(params.views, mesh.bboxCentre()), VKPOSE_TEST_CACHE_DIR)

@@ -16,7 +16,7 @@
 
 namespace vkpose::test {
 
-std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR)
+std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR), or $VKPOSE_TEST_SHARED_DATA where set
 bool haveSharedData();
 
 /// The real frames the parity tests use: LM-O scene 2 frame 3 and IC-BIN scene 2 frame 0.
