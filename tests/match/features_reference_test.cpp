@@ -1,5 +1,5 @@
-// The CPU reference of stage 1 against OpenCV, function by function, on real frames and odd
-// sizes.
+// The CPU reference of stage 1 against OpenCV, function by function, on real frames (or their
+// synthetic stand-ins) and odd sizes.
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rgbd/linemod.hpp>
 
@@ -21,10 +21,8 @@ std::vector<cv::Mat> testImages() {
   cv::randu(odd, 0, 256);
   cv::GaussianBlur(odd, odd, {5, 5}, 0);
   images.push_back(odd);
-  if (test::haveSharedData()) {
-    images.push_back(test::lmoFrame().bgr);
-    images.push_back(test::icbinFrame().bgr);
-  }
+  images.push_back(test::lmoFrameOrStandIn().bgr);
+  images.push_back(test::icbinFrameOrStandIn().bgr);
   return images;
 }
 
@@ -65,8 +63,7 @@ TEST(FeaturesReference, SpreadingMatchesTheDefinition) {
 // about 0.01 degrees; vkpose decides bins exactly. A pixel may differ only where its
 // gradient lies that close to a bin edge (or a neighbour's does, through the 3x3 vote).
 TEST(FeaturesReference, ColourQuantizationMatchesOpenCvColorGradient) {
-  VKPOSE_REQUIRE_SHARED_DATA();
-  for (const auto& frame : {test::lmoFrame(), test::icbinFrame()}) {
+  for (const auto& frame : {test::lmoFrameOrStandIn(), test::icbinFrameOrStandIn()}) {
     auto modality = cv::linemod::Modality::create("ColorGradient");
     auto pyramid = modality->process(frame.bgr, cv::Mat());
     cv::Mat bgr = frame.bgr;
@@ -91,8 +88,7 @@ TEST(FeaturesReference, ColourQuantizationMatchesOpenCvColorGradient) {
 // edges are jagged; vkpose bins the exact least-squares direction into 45-degree sectors
 // (same bits, same sector centres). They agree on the large majority of pixels.
 TEST(FeaturesReference, DepthQuantizationAgreesWithOpenCvDepthNormal) {
-  VKPOSE_REQUIRE_SHARED_DATA();
-  for (const auto& frame : {test::lmoFrame(), test::icbinFrame()}) {
+  for (const auto& frame : {test::lmoFrameOrStandIn(), test::icbinFrameOrStandIn()}) {
     auto modality = cv::linemod::Modality::create("DepthNormal");
     cv::Mat theirs;
     modality->process(frame.depth_mm, cv::Mat())->quantize(theirs);
@@ -106,7 +102,6 @@ TEST(FeaturesReference, DepthQuantizationAgreesWithOpenCvDepthNormal) {
 }
 
 TEST(FeaturesReference, DepthMedianIsOpenCvsMedianBlur) {
-  VKPOSE_REQUIRE_SHARED_DATA();
   // With a difference threshold of 1 mm every label is a lone pixel pattern the median must
   // treat exactly as OpenCV's medianBlur(5); the labels before the median are not exposed,
   // so compare on a label image whose raw labels are known: a flat scene with steps.

@@ -1,8 +1,10 @@
 #include "test_support.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "match/features.hpp"
 #include "match/matcher.hpp"
@@ -12,10 +14,17 @@
 #include "vkpose/error.hpp"
 #include "vkpose/frame.hpp"
 #include "vkpose/geometry.hpp"
+#include "vkpose/synth.hpp"
+#include "synth/procedural_meshes.hpp"
 
 namespace vkpose::test {
 
-std::string sharedData() { return VKPOSE_SHARED_DATA_DIR; }
+// VKPOSE_TEST_SHARED_DATA overrides the compiled-in folder, so that a run with the data on
+// disk can still play a newcomer without it (VKPOSE_TEST_SHARED_DATA=/nonexistent).
+std::string sharedData() {
+  if (const char* dir = std::getenv("VKPOSE_TEST_SHARED_DATA"); dir && *dir) return dir;
+  return VKPOSE_SHARED_DATA_DIR;
+}
 
 TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params) {
   return loadOrTrainBank(context(), mesh, params, sampleViews(params.views, mesh.bboxCentre()), VKPOSE_TEST_CACHE_DIR)
@@ -32,6 +41,48 @@ LinemodFrame lmoFrame() {
 LinemodFrame icbinFrame() {
   const std::string d = sharedData() + "/icbin/scene2/";
   return loadFrame(d + "rgb/0000.png", d + "depth/0000.png");
+}
+
+namespace {
+
+/// A frame of vkpose's own synthetic data: the demo's objects (a few instances each) and
+/// clutter, with the sensor's noise; the same frame on every run.
+LinemodFrame syntheticFrame(Layout layout, uint32_t seed) {
+  static const std::vector<Mesh> objects = demoMeshes();
+  SynthParams params;
+  params.seed = seed;
+  params.min_instances = 2;
+  params.max_instances = 3;
+  params.clutter = 6;
+  params.placement.layout = layout;
+  return synthesizeImage(context(), params, objects, 0).frame;
+}
+
+}  // namespace
+
+LinemodFrame lmoFrameOrStandIn() {
+  if (haveSharedData()) return lmoFrame();
+  static const LinemodFrame frame = syntheticFrame(Layout::Bin, 7);
+  return {frame.bgr.clone(), frame.depth_mm.clone()};
+}
+
+LinemodFrame icbinFrameOrStandIn() {
+  if (haveSharedData()) return icbinFrame();
+  static const LinemodFrame frame = syntheticFrame(Layout::Table, 8);
+  return {frame.bgr.clone(), frame.depth_mm.clone()};
+}
+
+std::string frameName(const std::string& name) {
+  return haveSharedData() ? name : name + "'s synthetic stand-in";
+}
+
+Mesh meshOrStandIn(const std::string& path, MeshUnits units) {
+  if (haveSharedData()) return loadMesh(sharedData() + "/" + path, units);
+  if (path.find("coffee_cup") != std::string::npos) return liddedCupMesh();
+  if (path.find("juicecarton") != std::string::npos || path.find("milk") != std::string::npos ||
+      path.find("obj_000005") != std::string::npos)
+    return gableCartonMesh();
+  throw std::logic_error("no stand-in for " + path);
 }
 
 std::vector<LinemodTemplate> templatesFrom(const LinemodFrame& frame, const FeatureParams& params, int count,

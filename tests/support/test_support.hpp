@@ -13,15 +13,32 @@
 #include "match/features.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/bank.hpp"
+#include "vkpose/geometry.hpp"
 
 namespace vkpose::test {
 
-std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR)
+std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR), or $VKPOSE_TEST_SHARED_DATA where set
 bool haveSharedData();
 
 /// The real frames the parity tests use: LM-O scene 2 frame 3 and IC-BIN scene 2 frame 0.
 LinemodFrame lmoFrame();
 LinemodFrame icbinFrame();
+
+// Stand-ins for tests that need "some frame" or "some mesh", not these in particular (GPU ==
+// CPU parity, OpenCV parity, a mesh to render or train): the real data where it is there, so
+// that CI's results stay what they were, and otherwise something vkpose makes itself, so that
+// a newcomer without ../shared still runs them.
+
+/// LM-O's frame, or else a synthetic 640 x 480 bin scene of the demo's three objects.
+LinemodFrame lmoFrameOrStandIn();
+/// IC-BIN's frame, or else another synthetic scene (another seed, a table).
+LinemodFrame icbinFrameOrStandIn();
+/// `name` ("LM-O") where the real frames are used, otherwise `name` marked as a stand-in.
+std::string frameName(const std::string& name);
+/// The mesh at `path` under sharedData() ("meshes/coffee_cup.stl"), loaded with `units`, or
+/// else a procedural object of the same kind and size (synth/procedural_meshes.hpp): the
+/// lidded cup for the coffee cup, the gable-top carton for the cartons and LM-O's can.
+Mesh meshOrStandIn(const std::string& path, MeshUnits units = MeshUnits::Auto);
 
 /// Templates cut with OpenCV's extraction from regions of `frame` (objects' boxes and
 /// random boxes); `count` at most.

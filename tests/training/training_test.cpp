@@ -59,8 +59,7 @@ TEST(Training, InPlaneRotationOfARenderingEqualsRenderingTheRotatedView) {
 }
 
 TEST(Training, FeaturesFollowLinemodSelection) {
-  VKPOSE_REQUIRE_SHARED_DATA();
-  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  const Mesh cup = test::meshOrStandIn("meshes/coffee_cup.stl", MeshUnits::Metres);
   MeshRenderer renderer(test::context(), cup);
   const Camera cam = squareCamera(220);
   const TrainingView v = lookAtView({0.5f, -0.6f, 0.6f}, cup.bboxCentre(), 0.6f, 10.f);
@@ -131,10 +130,9 @@ void expectSameQuantization(const QuantizedView& a, const QuantizedView& b, cons
 }
 
 TEST(Training, GpuQuantizationOfPackedCropsEqualsTheReferenceOneByOne) {
-  VKPOSE_REQUIRE_SHARED_DATA();
   // Crops of several sizes (three distances, two objects, in-plane turns), packed into small
   // atlases so that they fill several shelves and several atlases.
-  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  const Mesh cup = test::meshOrStandIn("meshes/coffee_cup.stl", MeshUnits::Metres);
   const Mesh l = test::lShapeMesh();
   const Camera cam = squareCamera(260);
   FeatureParams params;
@@ -164,9 +162,8 @@ TEST(Training, GpuQuantizationOfPackedCropsEqualsTheReferenceOneByOne) {
 }
 
 TEST(Training, TheFeatureCropGivesTheWholeTilesTemplate) {
-  VKPOSE_REQUIRE_SHARED_DATA();
   // featureCrop's margin is small: the crop must still give what the whole tile gives.
-  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  const Mesh cup = test::meshOrStandIn("meshes/coffee_cup.stl", MeshUnits::Metres);
   MeshRenderer renderer(test::context(), cup);
   const Camera cam = squareCamera(240);
   TrainingParams params;
@@ -185,8 +182,7 @@ TEST(Training, TheFeatureCropGivesTheWholeTilesTemplate) {
 }
 
 TEST(Training, TemplatesAreTheSameWhereverTheViewsAreQuantized) {
-  VKPOSE_REQUIRE_SHARED_DATA();
-  const Mesh cup = loadMesh(test::sharedData() + "/meshes/coffee_cup.stl", MeshUnits::Metres);
+  const Mesh cup = test::meshOrStandIn("meshes/coffee_cup.stl", MeshUnits::Metres);
   TrainingParams params;
   params.views.viewpoints = 6;
   params.views.radii = {0.6f, 0.8f, 0.2f};
