@@ -232,7 +232,7 @@ void validateRefineParams(const RefineParams& params);
 struct VerifyParams {
   /// Octree leaf size, metres. Real depth is noisy: on LM-O (object 5, about 1 m away) a
   /// correct refined pose scored 0.50 at 4 mm and 0.77 at 8 mm, a pose 2 cm off at most 0.15
-  /// and 0.35 (tests/verify_test.cpp). Tune with the threshold.
+  /// and 0.35 (tests/pose/verify_test.cpp). Tune with the threshold.
   float resolution = 0.004f;
   /// Accept if the collision rate exceeds this. Measured on LM-O (scene 2, image 3) at 4 mm
   /// leaves: correct refined poses 0.42-0.64, wrong ones that pass the other two tests up to 0.38.
