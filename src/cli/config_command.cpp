@@ -28,11 +28,9 @@ void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what
                               names, sensorProfileNames().front(), what));
 }
 
-CLI::Option* addParamFlag(CLI::App* sub, DetectorParams& params, const std::string& flag, const std::string& note) {
-  const std::vector<ConfigField> fields = configFields(params);
-  const auto f = std::find_if(fields.begin(), fields.end(),
-                              [&](const ConfigField& c) { return c.flag == flag || c.flag == "!" + flag; });
-  if (f == fields.end()) throw std::logic_error("no stage parameter has the flag " + flag);
+namespace {
+/// The flag of one table entry, bound to the field its pointer names.
+CLI::Option* addFieldFlag(CLI::App* sub, const ConfigField* f, const std::string& note) {
   std::string help = f->doc + note + fmt::format(" ({}.{})", f->section, f->key);
   help[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(help[0])));
   return std::visit(
@@ -59,11 +57,19 @@ CLI::Option* addParamFlag(CLI::App* sub, DetectorParams& params, const std::stri
       },
       f->value);
 }
+}  // namespace
+
+CLI::Option* addParamFlag(CLI::App* sub, DetectorParams& params, const std::string& flag, const std::string& note) {
+  const std::vector<ConfigField> fields = configFields(params);
+  const auto f = std::find_if(fields.begin(), fields.end(),
+                              [&](const ConfigField& c) { return c.flag == flag || c.flag == "!" + flag; });
+  if (f == fields.end()) throw std::logic_error("no stage parameter has the flag " + flag);
+  return addFieldFlag(sub, &*f, note);
+}
 
 void addStageFlags(CLI::App* sub, DetectorParams& params, const std::string& group) {
-  DetectorParams defaults;
-  for (const ConfigField& f : configFields(defaults))
-    if (!f.flag.empty()) addParamFlag(sub, params, f.flag[0] == '!' ? f.flag.substr(1) : f.flag)->group(group);
+  for (const ConfigField& f : configFields(params))
+    if (!f.flag.empty()) addFieldFlag(sub, &f, {})->group(group);
 }
 
 DetectorParams withConfig(const std::string& path, const DetectorParams& from_flags) {
