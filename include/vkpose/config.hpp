@@ -217,6 +217,16 @@ struct RefineParams {
   /// scene's surfaces already, and an outline without depth steps there stays without them
   /// (LM-O: 20 such starts of four objects, none a detection after MLS and ICP).
   float first_fit_pulled_see_through = 0.05f;
+  /// ... and, where the mesh has colours and verify.min_colour_agreement is on, a rendering
+  /// of the first fit whose chromaticity agrees with the frame's less than that limit minus
+  /// first_fit_colour_margin (firstFitColours): another object of the shape in the wrong
+  /// colour, which MLS and ICP do not change.
+  float first_fit_colour_margin = 0.1f;
+  /// A start whose first fit lies within verify.twin_distance_fraction of the diameter and
+  /// this angle of a better start's first fit of its object stops: MLS and ICP bring both to
+  /// one pose (LM-O: 5.1-5.9 degrees apart at the first fit, stage 8's twins or duplicates;
+  /// 9.7 degrees apart, the second became the glue's detection where the first failed).
+  float first_fit_twin_angle_deg = 7.5f;
   /// Of the starts whose first fits put an object's centre in one place (closer than
   /// detector.duplicate_fraction of the diameter), this many go on, the best by stage 8's score
   /// at the first fit; only one of them can be a detection, and the first fit's ranking is not

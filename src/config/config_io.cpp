@@ -98,6 +98,10 @@ std::vector<ConfigField> poseFields(DetectorParams& p) {
        "a start goes on when its first fit's silhouette support reaches this share of verify.min_silhouette_support", &p.refine.first_fit_silhouette_share, closed(0, 1)},
       {"refine", "first_fit_pulled_see_through",
        "a start above the collision limit seeing through this share at its first fit waits for stage 8's outline tests", &p.refine.first_fit_pulled_see_through, closed(0, 1)},
+      {"refine", "first_fit_colour_margin",
+       "a start whose mesh has colours goes on when its first fit's colours agree with the frame's to verify.min_colour_agreement less this", &p.refine.first_fit_colour_margin, closed(0, 2)},
+      {"refine", "first_fit_twin_angle_deg",
+       "a start whose first fit lies this close in angle (and verify.twin_distance_fraction in place) to a better one of its object stops", &p.refine.first_fit_twin_angle_deg, closed(0, 180)},
       {"refine", "first_fit_per_place",
        "starts of one object in one place after the first fit that go on (0: all)", &p.refine.first_fit_per_place, atLeast(0)},
   };

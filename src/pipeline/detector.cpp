@@ -210,6 +210,7 @@ void Detector::estimatePoses(const std::vector<Hypothesis>& clusters, const Scor
   if (params_.refine.first_fit) {
     firstFits(candidates, frame, threads);
     screenStarts(candidates);
+    firstFitColours(candidates, objects_, frame, threads);
     clock.end(Stage::first_fit, result);
   }
   std::pair<double, double> mls_ms, icp_ms, measure_ms;

@@ -129,6 +129,11 @@ bool samePlace(const Pose& a, std::size_t bank_a, const Pose& b, std::size_t ban
   return (placed(a, ba.centre) - placed(b, bb.centre)).norm() < duplicate_fraction * std::min(ba.diameter, bb.diameter);
 }
 
+bool samePose(const Pose& a, const Pose& b, const TemplateBank& bank, float distance_fraction, float angle_deg) {
+  return (placed(a, bank.centre) - placed(b, bank.centre)).norm() <= distance_fraction * bank.diameter &&
+         Eigen::AngleAxisf(a.R.transpose() * b.R).angle() <= angle_deg * static_cast<float>(M_PI) / 180.f;
+}
+
 float poseScore(float collision_rate, float see_through, float silhouette_support) {
   return collision_rate * (1.f - see_through) * silhouette_support;
 }
@@ -151,17 +156,14 @@ void markTwins(std::vector<PoseCandidate>& candidates, const std::vector<Templat
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return poseScore(candidates[a].evidence) > poseScore(candidates[b].evidence);
   });
-  const float max_angle_rad = params.twin_angle_deg * static_cast<float>(M_PI) / 180.f;
   std::vector<std::size_t> kept;
   for (const std::size_t i : order) {
     PoseCandidate& c = candidates[i];
     const TemplateBank& bank = banks[c.bank()];
     const Pose& p = c.refined.pose;
     for (const std::size_t k : kept) {
-      const Pose& q = candidates[k].refined.pose;
       if (candidates[k].bank() != c.bank() ||
-          (placed(p, bank.centre) - placed(q, bank.centre)).norm() > params.twin_distance_fraction * bank.diameter ||
-          Eigen::AngleAxisf(p.R.transpose() * q.R).angle() > max_angle_rad)
+          !samePose(p, candidates[k].refined.pose, bank, params.twin_distance_fraction, params.twin_angle_deg))
         continue;
       c.twin = true;
       break;

@@ -18,6 +18,10 @@ namespace vkpose {
 bool samePlace(const Pose& a, std::size_t bank_a, const Pose& b, std::size_t bank_b,
                const std::vector<TemplateBank>& banks, float duplicate_fraction);
 
+/// Whether two poses of one object are one pose: their centres within distance_fraction of
+/// the diameter and their rotations within angle_deg (stage 8's twins, and the first fit's).
+bool samePose(const Pose& a, const Pose& b, const TemplateBank& bank, float distance_fraction, float angle_deg);
+
 /// A verified pose's score: the collision rate, times the share not seen through, times the
 /// outline's support (Detection::score).
 float poseScore(float collision_rate, float see_through, float silhouette_support);

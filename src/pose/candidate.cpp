@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -224,6 +225,48 @@ void screenStarts(std::vector<PoseCandidate>& candidates) {
     if (c.initial.ok && c.refine.first_fit) c.screened = firstFitShortfall(c);
 }
 
+void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                     const PoseFrame& frame, unsigned threads) {
+  std::vector<std::size_t> which;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const PoseCandidate& c = candidates[i];
+    if (c.refinable() && c.refine.first_fit && !objects[c.bank()].bank->mesh.colours.empty() &&
+        c.verify.min_colour_agreement > -1.f)
+      which.push_back(i);
+  }
+  // Rendering is the GPU's, one small submit a start in the calling thread (as stage 6's).
+  std::vector<Rendering> views(which.size());
+  std::vector<cv::Rect> windows(which.size());
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const PoseCandidate& c = candidates[which[k]];
+    const PoseObject& o = objects[c.bank()];
+    windows[k] = projectedWindow(c.first_fit.pose, o.bank->centre, o.bounding_radius, frame.camera);
+    if (!windows[k].empty())
+      views[k] = std::move(o.renderer->render(windowCamera(frame.camera, windows[k]), {c.first_fit.pose}).front());
+  }
+  util::parallelFor(
+      which.size(),
+      [&](std::size_t k) {
+        PoseCandidate& c = candidates[which[k]];
+        if (windows[k].empty()) return;
+        const auto start = std::chrono::steady_clock::now();
+        const AppearanceAgreement a = appearanceAgreement(views[k], windows[k], frame.bgr, frame.depth_m,
+                                                          c.verify.see_through_tolerance, true);
+        views[k] = {};
+        if (a.colour_informative) c.first_colour = a.colour;
+        c.cpu_ms += msSince(start);
+      },
+      threads);
+  for (const std::size_t i : which) {
+    PoseCandidate& c = candidates[i];
+    const float limit = c.verify.min_colour_agreement - c.refine.first_fit_colour_margin;
+    if (c.first_colour < limit)  // false for NaN: colours that said too little stop nothing
+      c.screened = fmt::format("its colours do not match the scene's after the first fit (agreement {:.2f}, at least "
+                               "{:.2f} to go on)",
+                               c.first_colour, limit);
+  }
+}
+
 std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
                                    float duplicate_fraction) {
   // Without the first fit every start goes at once; with it, best first (ties keep the
@@ -244,21 +287,26 @@ std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const
     if (c.measured) continue;
     const TemplateBank& bank = banks[c.bank()];
     int same_object = 0;
-    bool waits = false;
+    bool waits = false, twin = false;
     const PoseCandidate* passed = nullptr;
-    for (std::size_t j = 0; j < k && !passed; ++j) {
+    for (std::size_t j = 0; j < k && !passed && !twin; ++j) {
       const PoseCandidate& better = candidates[order[j]];
       if (!better.screened.empty() ||
           !samePlace(better.first_fit.pose, better.bank(), c.first_fit.pose, c.bank(), banks, duplicate_fraction))
         continue;
-      if (better.bank() == c.bank())
+      if (better.bank() == c.bank()) {
         ++same_object;  // refined alongside: the first fit's ranking is not the final one
-      else if (!better.measured)
+        twin = samePose(better.first_fit.pose, c.first_fit.pose, bank, c.verify.twin_distance_fraction,
+                        c.refine.first_fit_twin_angle_deg);
+      } else if (!better.measured) {
         waits = true;
-      else if (stageEightShortfall(better).empty())
+      } else if (stageEightShortfall(better).empty()) {
         passed = &better;
+      }
     }
-    if (passed)
+    if (twin)
+      c.screened = fmt::format("the same pose after the first fit as a better start of {}", bank.object);
+    else if (passed)
       c.screened = fmt::format("a better start of {} in the same place passed stage 8 after the first fit",
                                banks[passed->bank()].object);
     else if (c.refine.first_fit_per_place > 0 && same_object >= c.refine.first_fit_per_place)

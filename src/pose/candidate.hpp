@@ -13,6 +13,7 @@
 // the competition between poses). Candidates are independent: each function runs them on
 // `threads` threads with results identical to one thread.
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,9 @@ struct PoseCandidate {
   PoseEvidence evidence;   ///< stage 8
   RefineResult first_fit;        ///< stage 7's first fit (firstFits)
   PoseEvidence first_evidence;   ///< stage 8's tests at the first fit (no scene cells)
+  /// The chromaticity concordance of its first fit's rendering with the frame
+  /// (firstFitColours); NaN where it was not measured or the colours said too little.
+  float first_colour = std::numeric_limits<float>::quiet_NaN();
   /// The collision rate its first fit needs to go on (initialPoses; RefineParams::first_fit_share).
   float first_fit_min_collision = 0.f;
   /// Why the first fit stopped it (screenStarts, nextRound); empty: it goes on to MLS and ICP.
@@ -131,11 +135,20 @@ void firstFits(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, u
 /// image-edge support: first_fit_contour_share).
 void screenStarts(std::vector<PoseCandidate>& candidates);
 
+/// Stage 7, after screenStarts: each start still going whose mesh has colours and whose
+/// colour test is on (verify.min_colour_agreement > -1) is rendered at its first fit (one
+/// small submit each, in the calling thread) and stops where its colours disagree with the
+/// frame's (RefineParams::first_fit_colour_share of stage 8's limit): another object of the
+/// right shape and the wrong colour, which MLS and ICP would not change.
+void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                     const PoseFrame& frame, unsigned threads);
+
 /// Stage 7, the next round of refinement: the indices of the candidates that MLS, ICP and
 /// stage 8 take next. Without the first fit, every placed one in one round. With it, ranked
-/// by stage 8's score at the first fit, a start stops (screened) where first_fit_per_place
-/// better starts of its object lie in its place (centres closer than duplicate_fraction of
-/// the diameter) or where a better start of another object (the smaller diameter's place)
+/// by stage 8's score at the first fit, a start stops (screened) where a better start of its
+/// object lies at the same pose (RefineParams::first_fit_twin_angle_deg), where
+/// first_fit_per_place better starts of its object lie in its place (centres closer than
+/// duplicate_fraction of the diameter) or where a better start of another object (the smaller diameter's place)
 /// passed stage 8's tests (stageEightShortfall); it waits while such a start is not measured
 /// yet, and goes otherwise. Empty when every placed candidate is measured or stopped. The
 /// rounds depend on the measurements only, never on the threads.

@@ -398,5 +398,65 @@ TEST(FirstFit, KeepsTheBestTwoOfAnObjectInAPlaceAndLetsAnotherObjectWaitForThem)
   EXPECT_TRUE(nextRound(c, banks, 0.3f).empty());
 }
 
+TEST(FirstFit, StopsAStartAtTheSamePoseAsABetterOneOfItsObject) {
+  const auto banks = twoTenCentimetreObjects();
+  std::vector<PoseCandidate> c;
+  c.push_back(firstFitStart(0, {0.000f, 0, 0.7f}, 0.7f, 0.f, 0.9f));  // best
+  c.push_back(firstFitStart(0, {0.003f, 0, 0.7f}, 0.6f, 0.f, 0.9f));  // 3 mm, 6 degrees away: one pose
+  c[1].first_fit.pose.R = rot(6.f, {0, 0, 1});
+  c.push_back(firstFitStart(0, {0.003f, 0, 0.7f}, 0.5f, 0.f, 0.9f));  // 3 mm, 20 degrees: another pose
+  c[2].first_fit.pose.R = rot(20.f, {0, 0, 1});
+  c.push_back(firstFitStart(1, {0.001f, 0, 0.7f}, 0.5f, 0.f, 0.9f));  // another object: waits
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{0, 2}));
+  EXPECT_NE(c[1].screened.find("the same pose after the first fit as a better start of cup"), std::string::npos)
+      << c[1].screened;
+  EXPECT_TRUE(c[3].screened.empty()) << c[3].screened;
+  // 0 degrees: only one pose exactly is the same.
+  for (auto& x : c) x.screened.clear(), x.refine.first_fit_twin_angle_deg = 0.f;
+  EXPECT_EQ(nextRound(c, banks, 0.3f), (std::vector<std::size_t>{0, 1}));
+}
+
+TEST(FirstFit, StopsAStartWhoseColoursDisagreeWithTheFrame) {
+  TranslationCase scene = translationCase({0.f, 0.f, 0.f});
+  Mesh box = scene.box;
+  box.colours.assign(box.vertices.size(), Eigen::Vector3f(0.8f, 0.2f, 0.1f));  // orange-red
+  TemplateBank bank;
+  bank.object = "box";
+  bank.mesh = box;
+  bank.diameter = box.diameter;
+  MeshRenderer renderer(test::context(), box);
+  PoseObject object;
+  object.bank = &bank;
+  object.renderer = &renderer;
+  object.bounding_radius = 0.5f * box.diameter;
+  const Rendering seen = renderer.render(scene.camera, {scene.truth}).front();
+  cv::Mat red = seen.bgr.clone();
+  red.setTo(cv::Scalar(128, 128, 128), seen.depth == 0.f);  // a grey wall behind
+  std::vector<cv::Mat> channels;
+  cv::split(red, channels);
+  std::swap(channels[1], channels[2]);
+  cv::Mat green;
+  cv::merge(channels, green);
+  const auto start = [&] {
+    PoseCandidate c = firstFitStart(0, scene.truth.t, 0.8f, 0.f, 0.9f);
+    c.first_fit.pose = scene.truth;
+    return std::vector<PoseCandidate>{c};
+  };
+  std::vector<PoseCandidate> same = start(), other = start();
+  firstFitColours(same, {object}, poseFrame(scene.camera, scene.scene_depth, red), 2);
+  EXPECT_TRUE(same[0].refinable()) << same[0].screened;
+  EXPECT_GT(same[0].first_colour, 0.8f);
+  firstFitColours(other, {object}, poseFrame(scene.camera, scene.scene_depth, green), 2);
+  EXPECT_LT(other[0].first_colour, 0.1f);
+  EXPECT_NE(other[0].screened.find("its colours do not match the scene's after the first fit"), std::string::npos)
+      << other[0].screened;
+  // A mesh without colours is not rendered, and goes on.
+  bank.mesh.colours.clear();
+  std::vector<PoseCandidate> grey = start();
+  firstFitColours(grey, {object}, poseFrame(scene.camera, scene.scene_depth, green), 2);
+  EXPECT_TRUE(grey[0].refinable());
+  EXPECT_TRUE(std::isnan(grey[0].first_colour));
+}
+
 }  // namespace
 }  // namespace vkpose
