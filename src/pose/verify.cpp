@@ -1,5 +1,5 @@
-// Pose verification with OctoMap (docs/pipeline.md, stage 8): the collision rate of the posed model's
-// visible points against an octree of the scene points.
+// Pose verification with OctoMap (docs/pipeline.md, stage 8): the collision rate of the posed
+// model's visible points against the octree leaves the scene points occupy.
 #include "pose/verify.hpp"
 
 #include <algorithm>
@@ -188,36 +188,61 @@ std::vector<int> supportCells(const PointCloud& model_points, const cv::Mat& sce
   return cells;
 }
 
-VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
-                        const VerifyParams& params) {
-  validateVerifyParams(params);
+namespace {
 
-  const auto t0 = std::chrono::steady_clock::now();
-  VerifyResult result;
-  Eigen::AlignedBox3f box;  // the model's box: only scene points near it can be hit
+/// The model's box grown by the crop margin (only scene points in it can be hit) and its count
+/// of finite points; the box is empty without any.
+Eigen::AlignedBox3f hitBox(const PointCloud& visible_model_points, float crop_margin, std::size_t& model_points) {
+  Eigen::AlignedBox3f box;
+  model_points = 0;
   for (const auto& p : visible_model_points)
     if (p.allFinite()) {
       box.extend(p);
-      ++result.model_points;
+      ++model_points;
     }
+  if (model_points > 0) {
+    box.min().array() -= crop_margin;
+    box.max().array() += crop_margin;
+  }
+  return box;
+}
 
+/// The octree's leaves that the scene points in `box` fall in (OctoMap's key arithmetic).
+octomap::KeySet occupiedLeaves(const octomap::OcTree& tree, const PointCloud& scene_points,
+                               const Eigen::AlignedBox3f& box, std::size_t& scene_in_box) {
+  octomap::KeySet occupied;
+  octomap::OcTreeKey key;
+  scene_in_box = 0;
+  for (const auto& p : scene_points)
+    if (p.allFinite() && box.contains(p)) {
+      ++scene_in_box;
+      if (tree.coordToKeyChecked(p.x(), p.y(), p.z(), key)) occupied.insert(key);
+    }
+  return occupied;
+}
+
+/// The collision rate of the model points against the scene's occupied leaves: looked up in
+/// the set of their keys, or (`octree`) searched in the paper's OctoMap octree built from them.
+VerifyResult collisionRate(const PointCloud& visible_model_points, const PointCloud& scene_points,
+                           const VerifyParams& params, bool octree) {
+  validateVerifyParams(params);
+  const auto t0 = std::chrono::steady_clock::now();
+  VerifyResult result;
+  const Eigen::AlignedBox3f box = hitBox(visible_model_points, params.crop_margin, result.model_points);
   if (result.model_points > 0) {
-    box.min().array() -= params.crop_margin;
-    box.max().array() += params.crop_margin;
-    // One update per occupied leaf rather than per point: a dense crop puts tens of points
-    // in each 4 mm leaf, and the octree descent is the cost.
     octomap::OcTree tree(params.resolution);
-    octomap::KeySet occupied;
+    const octomap::KeySet occupied = occupiedLeaves(tree, scene_points, box, result.scene_points);
+    // One update per occupied leaf rather than per point: a dense crop puts tens of points in
+    // each 4 mm leaf, and the octree descent is the cost.
+    if (octree)
+      for (const auto& k : occupied) tree.updateNode(k, true, /*lazy_eval=*/true);  // leaves only
     octomap::OcTreeKey key;
-    for (const auto& p : scene_points)
-      if (p.allFinite() && box.contains(p)) {
-        ++result.scene_points;
-        if (tree.coordToKeyChecked(p.x(), p.y(), p.z(), key)) occupied.insert(key);
-      }
-    for (const auto& k : occupied) tree.updateNode(k, true, /*lazy_eval=*/true);  // leaves only
-
     for (const auto& p : visible_model_points) {
       if (!p.allFinite() || !tree.coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
+      if (!octree) {
+        result.hits += occupied.count(key);
+        continue;
+      }
       const octomap::OcTreeNode* node = tree.search(key);
       if (node && tree.isNodeOccupied(node)) ++result.hits;
     }
@@ -226,6 +251,22 @@ VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud
   result.accepted = result.model_points > 0 && result.collision_rate > params.threshold;
   result.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return result;
+}
+
+}  // namespace
+
+VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
+                        const VerifyParams& params) {
+  // Every occupied leaf of the octree is updated once, as occupied, and nothing is pruned: a
+  // model point's leaf is occupied exactly when its key is one of the scene's. The key set
+  // answers what the octree's search would (verifyPoseOctree; the parity test) without
+  // building the tree, which took 1.2 of the 1.8 ms of a first fit's measurements (IC-BIN).
+  return collisionRate(visible_model_points, scene_points, params, false);
+}
+
+VerifyResult verifyPoseOctree(const PointCloud& visible_model_points, const PointCloud& scene_points,
+                              const VerifyParams& params) {
+  return collisionRate(visible_model_points, scene_points, params, true);
 }
 
 }  // namespace vkpose

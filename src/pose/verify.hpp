@@ -85,4 +85,10 @@ float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageE
 VerifyResult verifyPose(const PointCloud& visible_model_points, const PointCloud& scene_points,
                         const VerifyParams& params = {});
 
+/// verifyPose by the paper's octree itself: the scene's leaves inserted into an OctoMap
+/// OcTree and each model point's leaf searched. The reference that verifyPose's key set
+/// answers the same as (the parity test); about 1.2 ms more per call on a crop.
+VerifyResult verifyPoseOctree(const PointCloud& visible_model_points, const PointCloud& scene_points,
+                              const VerifyParams& params = {});
+
 }  // namespace vkpose

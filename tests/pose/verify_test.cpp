@@ -1,5 +1,6 @@
 // Pose verification (stage 8): the collision rate of the posed model's visible points against
 // an octree of the scene.
+#include <cmath>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -44,6 +45,35 @@ TEST(Verify, CorrectPoseCollidesAlmostEverywhere) {
   EXPECT_TRUE(r.accepted);
   EXPECT_GT(r.model_points, 1000u);
   EXPECT_GT(r.scene_points, s.scene.size() / 2);  // the object and the background near it
+}
+
+// verifyPose looks the model points' leaves up in the set of the scene's; the paper's octree,
+// built from the same leaves and searched, must count the same hits at every resolution, for
+// right and wrong poses, with points outside the octree's range and non-finite ones.
+TEST(Verify, TheLeafSetCountsWhatTheOctreeCounts) {
+  const Scene s;
+  PointCloud scene = s.scene;
+  scene.push_back({std::numeric_limits<float>::quiet_NaN(), 0.f, 0.7f});
+  scene.push_back({1e6f, 0.f, 0.7f});  // beyond any octree's range at 2 mm
+  const Eigen::Vector3f to_camera = -s.truth.t.normalized();
+  int compared = 0;
+  for (const float resolution : {0.002f, 0.004f, 0.008f})
+    for (const float shift : {0.f, 0.004f, 0.01f, 0.03f})
+      for (const float turn : {0.f, 10.f}) {
+        const Pose pose{Eigen::AngleAxisf(turn * float(M_PI) / 180.f, Eigen::Vector3f::UnitY()) * s.truth.R,
+                        s.truth.t + shift * to_camera};
+        VerifyParams p;
+        p.resolution = resolution;
+        const VerifyResult set = verifyPose(s.visibleAt(pose), scene, p);
+        const VerifyResult tree = verifyPoseOctree(s.visibleAt(pose), scene, p);
+        EXPECT_EQ(set.hits, tree.hits) << resolution << " " << shift << " " << turn;
+        EXPECT_EQ(set.model_points, tree.model_points);
+        EXPECT_EQ(set.scene_points, tree.scene_points);
+        EXPECT_EQ(set.collision_rate, tree.collision_rate);
+        EXPECT_EQ(set.accepted, tree.accepted);
+        compared += set.hits > 0;
+      }
+  EXPECT_GT(compared, 12);  // most poses hit something: the counts compared are not all zero
 }
 
 // Towards the camera nothing collides; sideways the L's long bar still overlaps itself a
