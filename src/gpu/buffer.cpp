@@ -87,12 +87,10 @@ void Buffer::reserve(const GpuContext& ctx, std::size_t bytes, MemoryKind kind) 
                 vk::BufferUsageFlagBits::eTransferSrc |
                 vk::BufferUsageFlagBits::eTransferDst | vk::BufferUsageFlagBits::eIndirectBuffer});
   auto req = s.device.getBufferMemoryRequirements(buffer);
-  const auto flags = host ? vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent
-                          : vk::MemoryPropertyFlags(vk::MemoryPropertyFlagBits::eDeviceLocal);
   vk::DeviceMemory memory;
   try {
     memory = s.device.allocateMemory({.allocationSize = req.size,
-                                      .memoryTypeIndex = s.memoryType(req.memoryTypeBits, flags)});
+                                      .memoryTypeIndex = chooseMemoryType(s.memory, req.memoryTypeBits, host, s.info.name)});
   } catch (const vk::OutOfDeviceMemoryError&) {
     s.device.destroyBuffer(buffer);
     throw outOfMemory(s, req.size, "(the allocation failed)");

@@ -198,10 +198,27 @@ std::size_t chooseGpuDevice(const std::vector<GpuDeviceInfo>& devices, const Gpu
   return best;
 }
 
-uint32_t gpu::ContextState::memoryType(uint32_t type_bits, vk::MemoryPropertyFlags flags) const {
-  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i)
-    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return i;
-  throw DeviceError("no Vulkan memory type with the properties vkpose needs on " + info.name);
+namespace {
+/// The first type allowed by type_bits with all of flags, or -1.
+int firstMemoryType(const vk::PhysicalDeviceMemoryProperties& memory, uint32_t type_bits,
+                    vk::MemoryPropertyFlags flags) {
+  for (uint32_t i = 0; i < memory.memoryTypeCount && i < 32; ++i)
+    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return static_cast<int>(i);
+  return -1;
+}
+}  // namespace
+
+uint32_t gpu::chooseMemoryType(const vk::PhysicalDeviceMemoryProperties& memory, uint32_t type_bits,
+                               bool host_visible, const std::string& device_name) {
+  using F = vk::MemoryPropertyFlagBits;
+  const vk::MemoryPropertyFlags mapped = F::eHostVisible | F::eHostCoherent;
+  int i = host_visible ? firstMemoryType(memory, type_bits, mapped | F::eHostCached)
+                       : firstMemoryType(memory, type_bits, F::eDeviceLocal);
+  if (i < 0 && host_visible) i = firstMemoryType(memory, type_bits, mapped);
+  if (i < 0)
+    throw DeviceError(std::string("no Vulkan memory type for ") + (host_visible ? "mapped" : "device-local") +
+                      " buffers on " + device_name);
+  return static_cast<uint32_t>(i);
 }
 
 GpuContext::GpuContext(const GpuOptions& options) : state_(std::make_unique<gpu::ContextState>()) {

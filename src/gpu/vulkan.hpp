@@ -4,6 +4,7 @@
 #include <vulkan/vulkan.hpp>
 
 #include <atomic>
+#include <string>
 
 #include "vkpose/device.hpp"
 
@@ -33,9 +34,15 @@ struct ContextState {
   uint64_t memory_limit = 0;
   PFN_vkCreateDebugUtilsMessengerEXT create_messenger = nullptr;
   PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
-
-  /// Index of a memory type allowed by `type_bits` with all of `flags`; throws if none.
-  uint32_t memoryType(uint32_t type_bits, vk::MemoryPropertyFlags flags) const;
 };
+
+/// The memory type a buffer of `host_visible` memory (mapped: staging, match candidates) or
+/// device-local memory takes among those `type_bits` allows: device-local memory the first
+/// device-local type; mapped memory host-visible and coherent, host-cached where a type is,
+/// because the host reads it back. A discrete GPU's first mapped type is write-combined
+/// (NVIDIA) or the device's own memory seen through the PCIe BAR: written fast, read by the
+/// CPU at a fraction of memory speed. Throws DeviceError when no type fits.
+uint32_t chooseMemoryType(const vk::PhysicalDeviceMemoryProperties& memory, uint32_t type_bits, bool host_visible,
+                          const std::string& device_name);
 
 }  // namespace vkpose::gpu
