@@ -133,9 +133,9 @@ TEST(LmoPose, FindsTheVisibleObjectsWithDepthAndTheClearOnesWithout) {
   for (std::size_t i = 0; i < run.errors.size(); ++i)
     EXPECT_LT(run.errors[i], 0.15f) << run.result.detections[i].object << " at " << run.result.detections[i].x << ","
                                     << run.result.detections[i].y << " is wrong by " << run.errors[i] << " d";
-  // The first fit stops most starts before MLS and ICP: 24 refined for 6 detections today, 359
-  // without it.
-  EXPECT_LE(static_cast<double>(run.result.refined_candidates), 5.0 * static_cast<double>(run.errors.size()));
+  // The first fit stops most starts before MLS and ICP: 14 refined for 6 detections today, 359
+  // without it; issue 48 asks for at most 2.5 a detection.
+  EXPECT_LE(static_cast<double>(run.result.refined_candidates), 2.5 * static_cast<double>(run.errors.size()));
   // Every pose stage is timed.
   std::vector<std::string> stages;
   for (const auto& [name, ms] : run.result.timings_ms) stages.push_back(name);
