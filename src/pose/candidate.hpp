@@ -137,9 +137,9 @@ void screenStarts(std::vector<PoseCandidate>& candidates);
 
 /// Stage 7, after screenStarts: each start still going whose mesh has colours and whose
 /// colour test is on (verify.min_colour_agreement > -1) is rendered at its first fit (one
-/// small submit each, in the calling thread) and stops where its colours disagree with the
-/// frame's (RefineParams::first_fit_colour_share of stage 8's limit): another object of the
-/// right shape and the wrong colour, which MLS and ICP would not change.
+/// small submit each, in the calling thread) and stops where its colours agree with the
+/// frame's less than stage 8's limit minus RefineParams::first_fit_colour_margin: another
+/// object of the right shape and the wrong colour, which MLS and ICP would not change.
 void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                      const PoseFrame& frame, unsigned threads);
 
@@ -148,8 +148,8 @@ void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<P
 /// by stage 8's score at the first fit, a start stops (screened) where a better start of its
 /// object lies at the same pose (RefineParams::first_fit_twin_angle_deg), where
 /// first_fit_per_place better starts of its object lie in its place (centres closer than
-/// duplicate_fraction of the diameter) or where a better start of another object (the smaller diameter's place)
-/// passed stage 8's tests (stageEightShortfall); it waits while such a start is not measured
+/// duplicate_fraction of the diameter) or where a better start of another object (the
+/// smaller diameter's place) passed stage 8's tests (stageEightShortfall); it waits while such a start is not measured
 /// yet, and goes otherwise. Empty when every placed candidate is measured or stopped. The
 /// rounds depend on the measurements only, never on the threads.
 std::vector<std::size_t> nextRound(std::vector<PoseCandidate>& candidates, const std::vector<TemplateBank>& banks,
