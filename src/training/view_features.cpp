@@ -20,18 +20,23 @@ struct Placement {
 struct AtlasPlan {
   std::vector<Placement> placements;
   std::vector<cv::Size> sizes;  // of each atlas
+  std::size_t pixels = 0;       // of all atlases together
 };
 
 int roundUp(int v, int to) { return (v + to - 1) / to * to; }
 
-AtlasPlan planAtlases(const std::vector<LinemodFrame>& crops, int align, int gap, std::size_t max_pixels) {
-  int width = 2048;
-  for (const auto& c : crops) width = std::max(width, roundUp(c.depth_mm.cols + 2 * gap, align));
+/// The crops in `order` onto shelves of atlases `width` pixels wide.
+AtlasPlan packShelves(const std::vector<LinemodFrame>& crops, const std::vector<std::size_t>& order, int width,
+                      int align, int gap, std::size_t max_pixels) {
   AtlasPlan plan;
+  plan.placements.resize(crops.size());
   int x = gap, y = gap, shelf = 0;
-  auto close = [&] { plan.sizes.emplace_back(width, roundUp(y + shelf + gap, align)); };
-  for (const auto& c : crops) {
-    const cv::Size s = c.depth_mm.size();
+  auto close = [&] {
+    plan.sizes.emplace_back(width, roundUp(y + shelf + gap, align));
+    plan.pixels += plan.sizes.back().area();
+  };
+  for (std::size_t i : order) {
+    const cv::Size s = crops[i].depth_mm.size();
     if (x + s.width + gap > width) {  // next shelf
       y = roundUp(y + shelf + gap, align);
       x = gap;
@@ -43,12 +48,34 @@ AtlasPlan planAtlases(const std::vector<LinemodFrame>& crops, int align, int gap
       y = gap;
       shelf = 0;
     }
-    plan.placements.push_back({plan.sizes.size(), {x, y}});
+    plan.placements[i] = {plan.sizes.size(), {x, y}};
     x = roundUp(x + s.width + gap, align);
     shelf = std::max(shelf, s.height);
   }
   if (!crops.empty()) close();
   return plan;
+}
+
+/// Tallest crops first, so that a shelf's crops are of about its height, at the atlas width
+/// that leaves the fewest pixels over: every atlas pixel costs the feature kernels the same,
+/// crop or gap (a 2,048-pixel atlas of training's crops in view order was 69 % crops).
+AtlasPlan planAtlases(const std::vector<LinemodFrame>& crops, int align, int gap, std::size_t max_pixels) {
+  std::vector<std::size_t> order(crops.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return crops[a].depth_mm.rows > crops[b].depth_mm.rows;
+  });
+  int narrowest = 0;
+  for (const auto& c : crops) narrowest = std::max(narrowest, roundUp(c.depth_mm.cols + 2 * gap, align));
+  // Widths from 1,024 pixels (no atlas much taller than wide) to 4,096, in steps that keep
+  // the alignment.
+  const int step = roundUp(64, align), widest = std::max(narrowest, 4096);
+  AtlasPlan best;
+  for (int width = std::max(narrowest, roundUp(1024, align)); width <= widest; width += step) {
+    AtlasPlan plan = packShelves(crops, order, width, align, gap, max_pixels);
+    if (best.sizes.empty() || plan.pixels < best.pixels) best = std::move(plan);
+  }
+  return best;
 }
 
 }  // namespace

@@ -38,8 +38,8 @@ class ViewQuantizer {
   /// level-0 pixels away (level 1's pyramid, blur, Sobel and vote), and the labels training
   /// reads lie within 8 pixels of the object's box, so another crop's object must stay 27
   /// pixels away: crops hold at least 12 pixels of background on every side (featureCrop's
-  /// margin, or the tile's where its edge cuts the crop), and 12 + 8 + 12 = 32.
-  static constexpr int kGap = 8;
+  /// margin, or the tile's where its edge cuts the crop), and 12 + 4 + 12 = 28.
+  static constexpr int kGap = 4;
 
  private:
   FeatureParams params_;
