@@ -4,9 +4,15 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "gpu/kernel_interface.h"
 
-layout(std430, binding = 0) readonly buffer Vertices { vec4 vertices[]; };
-layout(std430, binding = 1) readonly buffer Faces { uvec4 faces[]; };
-layout(std430, binding = 2) readonly buffer Poses { vec4 poses[]; };  // 3 rows (R | t) per view
+// The mesh and the poses in texel buffers: on lavapipe a texel fetch is one gather where a storage-buffer
+// load at a per-invocation offset is a loop over the lanes, and a triangle's setup (four such
+// loads) is nearly all of the raster pass's time.
+layout(binding = 0) uniform utextureBuffer vertex_texels;  // x, y, z as float bits, 0
+layout(binding = 1) uniform utextureBuffer face_texels;    // corner indices a, b, c, 0
+vec3 vertexAt(uint v) { return uintBitsToFloat(texelFetch(vertex_texels, int(v)).xyz); }
+uvec4 faceAt(uint f) { return texelFetch(face_texels, int(f)); }
+layout(binding = 2) uniform utextureBuffer pose_texels;   // 3 rows (R | t) per view, float bits
+vec4 poseRow(uint i) { return uintBitsToFloat(texelFetch(pose_texels, int(i))); }
 
 layout(push_constant) uniform RasterPushBlock { RasterPush pc; };
 
@@ -30,7 +36,7 @@ struct Triangle {
 };
 
 vec3 toCamera(uint view, vec3 v) {
-  vec4 r0 = poses[3u * view], r1 = poses[3u * view + 1u], r2 = poses[3u * view + 2u];
+  vec4 r0 = poseRow(3u * view), r1 = poseRow(3u * view + 1u), r2 = poseRow(3u * view + 2u);
   precise vec3 c = vec3(dot(r0.xyz, v) + r0.w, dot(r1.xyz, v) + r1.w, dot(r2.xyz, v) + r2.w);
   return c;
 }
@@ -59,7 +65,7 @@ bool projectPoint(vec3 p, out float rz_out, out ivec2 s) {
 // One corner: camera point, 1 / z and the fixed-point screen position; false when it lies
 // nearer than kNearZ or beyond the guard band (then the other outputs mean nothing).
 bool projectCorner(uint view, uint vertex, out vec3 p, out float rz_out, out ivec2 s) {
-  p = toCamera(view, vertices[vertex].xyz);
+  p = toCamera(view, vertexAt(vertex));
   const bool on_screen = projectPoint(p, rz_out, s);
   return p.z > kNearZ && on_screen;
 }
@@ -72,7 +78,7 @@ ivec4 pixelBox(ivec2 lo, ivec2 hi) {
 }
 
 bool setupTriangle(uint view, uint f, out Triangle t) {
-  uvec4 idx = faces[f];
+  uvec4 idx = faceAt(f);
   t.area = 0.0;
   t.sign = 1.0;
   t.box = ivec4(0, 0, -1, -1);
@@ -147,9 +153,9 @@ bool clipFace(uint view, uint f, out ClippedFace c) {
   c.wide = false;
   c.sign = 1.0;
   c.box = ivec4(0, 0, -1, -1);
-  uvec4 idx = faces[f];
-  vec3 p[3] = vec3[3](toCamera(view, vertices[idx.x].xyz), toCamera(view, vertices[idx.y].xyz),
-                      toCamera(view, vertices[idx.z].xyz));
+  uvec4 idx = faceAt(f);
+  vec3 p[3] = vec3[3](toCamera(view, vertexAt(idx.x)), toCamera(view, vertexAt(idx.y)),
+                      toCamera(view, vertexAt(idx.z)));
   if (!(p[0].z <= kNearZ || p[1].z <= kNearZ || p[2].z <= kNearZ)) return false;
   precise vec3 n = cross(p[1] - p[0], p[2] - p[0]);
   precise float n_p0 = dot(n, p[0]);
@@ -216,9 +222,9 @@ ivec2 bandRows(ivec4 box) {
 // from the corners' camera points: for clipped faces, whose own screen corners are not the
 // face's.
 vec3 faceWeights(uint view, uint f, vec3 point, out vec3 n_out) {
-  uvec4 idx = faces[f];
-  vec3 p0 = toCamera(view, vertices[idx.x].xyz), p1 = toCamera(view, vertices[idx.y].xyz),
-       p2 = toCamera(view, vertices[idx.z].xyz);
+  uvec4 idx = faceAt(f);
+  vec3 p0 = toCamera(view, vertexAt(idx.x)), p1 = toCamera(view, vertexAt(idx.y)),
+       p2 = toCamera(view, vertexAt(idx.z));
   precise vec3 n = cross(p1 - p0, p2 - p0);
   precise float inv = 1.0 / dot(n, n);
   precise float w0 = dot(cross(p1 - point, p2 - point), n) * inv;

@@ -4,9 +4,12 @@
 // colour, or grey shaded by a light at the camera).
 #include "raster_common.glsl"
 layout(local_size_x = kWorkgroupSize) in;
-layout(std430, binding = 3) readonly buffer Raster { uint64_t raster[]; };
-layout(std430, binding = 4) readonly buffer Normals { vec4 normals[]; };
-layout(std430, binding = 5) readonly buffer Colours { uint colours[]; };
+// Read through texel buffers (gathers on lavapipe), as the mesh in raster_common.glsl.
+layout(binding = 3) uniform utextureBuffer raster_texels;   // pass 1's keys: low word, high word
+layout(binding = 4) uniform utextureBuffer normal_texels;   // vertex normals, float bits
+layout(binding = 5) uniform utextureBuffer colour_texels;   // vertex colours, packed
+vec3 vertexNormal(uint v) { return uintBitsToFloat(texelFetch(normal_texels, int(v)).xyz); }
+vec3 vertexColour(uint v) { return unpackUnorm4x8(texelFetch(colour_texels, int(v)).x).xyz; }
 layout(std430, binding = 6) writeonly buffer Depth { float depth_out[]; };
 layout(std430, binding = 7) writeonly buffer NormalOut { vec4 normal_out[]; };
 layout(std430, binding = 8) writeonly buffer ColourOut { uint colour_out[]; };
@@ -19,7 +22,8 @@ void main() {
   uint pixels = uint(pc.width * pc.height);
   if (i >= pixels) return;
   uint o = view * pixels + i;
-  uint64_t key = raster[o];
+  const uvec2 words = texelFetch(raster_texels, int(o)).xy;
+  const uint64_t key = (uint64_t(words.y) << 32) | uint64_t(words.x);
   if (key == ~uint64_t(0)) {
     depth_out[o] = 0.0;
     normal_out[o] = vec4(0.0);
@@ -43,11 +47,11 @@ void main() {
                               (float(y) - pc.camera.cy) * (1.0 / pc.camera.fy), 1.0) * z;
     w = faceWeights(view, f, point, face_n);
   }
-  uvec4 idx = faces[f];
+  uvec4 idx = faceAt(f);
   precise vec3 n;
   if ((pc.flags & kRasterVertexNormals) != 0u) {
-    precise vec3 m = w.x * normals[idx.x].xyz + w.y * normals[idx.y].xyz + w.z * normals[idx.z].xyz;
-    vec4 r0 = poses[3u * view], r1 = poses[3u * view + 1u], r2 = poses[3u * view + 2u];
+    precise vec3 m = w.x * vertexNormal(idx.x) + w.y * vertexNormal(idx.y) + w.z * vertexNormal(idx.z);
+    vec4 r0 = poseRow(3u * view), r1 = poseRow(3u * view + 1u), r2 = poseRow(3u * view + 2u);
     n = vec3(dot(r0.xyz, m), dot(r1.xyz, m), dot(r2.xyz, m));
   } else {
     n = face_n;
@@ -58,8 +62,7 @@ void main() {
   if (dot(n, ray) > 0.0) n = -n;
   vec3 bgr;
   if ((pc.flags & kRasterVertexColours) != 0u) {
-    precise vec3 c = w.x * unpackUnorm4x8(colours[idx.x]).xyz + w.y * unpackUnorm4x8(colours[idx.y]).xyz +
-                     w.z * unpackUnorm4x8(colours[idx.z]).xyz;
+    precise vec3 c = w.x * vertexColour(idx.x) + w.y * vertexColour(idx.y) + w.z * vertexColour(idx.z);
     bgr = c;
   } else {
     precise float lambert = max(0.0, -dot(n, ray) * (1.0 / sqrt(dot(ray, ray))));

@@ -172,6 +172,14 @@ uint32_t rasterBands(const Camera& camera) {
   return (height + rows - 1) / rows;
 }
 constexpr std::size_t kMaxViewsPerBatch = 256;
+/// Vertices, faces and pose rows are texel buffers of four 32-bit words (raster_common.glsl).
+const std::vector<gpu::TexelBinding> kMeshTexels = {{0, vk::Format::eR32G32B32A32Uint},
+                                                    {1, vk::Format::eR32G32B32A32Uint},
+                                                    {2, vk::Format::eR32G32B32A32Uint}};
+/// The resolve pass also reads pass 1's 64-bit keys, the vertex normals and colours so.
+const std::vector<gpu::TexelBinding> kResolveTexels = {
+    {0, vk::Format::eR32G32B32A32Uint}, {1, vk::Format::eR32G32B32A32Uint}, {2, vk::Format::eR32G32B32A32Uint},
+    {3, vk::Format::eR32G32Uint},       {4, vk::Format::eR32G32B32A32Uint}, {5, vk::Format::eR32Uint}};
 }  // namespace
 
 struct RenderWorkspace {
@@ -189,9 +197,9 @@ struct MeshRenderer::Impl {
       : ctx(c),
         workspace(ws ? std::move(ws) : makeRenderWorkspace(c)),
         batch(workspace->batch),
-        raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush)),
-        clipped(c, gpu::ShaderId::raster_clipped, 4, sizeof(RasterPush)),
-        resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush)) {
+        raster(c, gpu::ShaderId::raster_depth, 4, sizeof(RasterPush), {}, kMeshTexels),
+        clipped(c, gpu::ShaderId::raster_clipped, 4, sizeof(RasterPush), {}, kMeshTexels),
+        resolve(c, gpu::ShaderId::raster_resolve, 9, sizeof(RasterPush), {}, kResolveTexels) {
     face_count = static_cast<uint32_t>(mesh.faces.size());
     centre = mesh.bboxCentre();
     for (const auto& v : mesh.vertices) radius = std::max(radius, (v - centre).norm());
@@ -209,7 +217,9 @@ struct MeshRenderer::Impl {
     for (const auto& colour : mesh.colours) c1.push_back(packBgr(colour));
     if (c1.empty()) c1.push_back(0);
     const std::size_t max_range = ctx.device().max_storage_buffer_range;
-    if (v4.size() * 4 > max_range || f4.size() * 4 > max_range)
+    const std::size_t max_texels = ctx.device().max_texel_buffer_elements;
+    if (v4.size() * 4 > max_range || f4.size() * 4 > max_range || v4.size() / 4 > max_texels ||
+        f4.size() / 4 > max_texels)
       throw InputError(fmt::format("mesh '{}' is too large for one device buffer ({} triangles)", mesh.name, face_count));
     vertices = gpu::Buffer(ctx, v4.size() * 4);
     faces = gpu::Buffer(ctx, f4.size() * 4);
@@ -253,7 +263,9 @@ std::size_t MeshRenderer::viewsPerBatch(const Camera& camera) const {
   // Largest per-pixel binding: the normals (16 bytes); the whole batch: 8 + 4 + 16 + 4.
   const std::size_t by_range = impl_->ctx.device().max_storage_buffer_range / (pixels * 16);
   const std::size_t by_budget = kBatchBytes / (pixels * 32);
-  return std::clamp<std::size_t>(std::min({by_range, by_budget, kMaxViewsPerBatch}), 1, kMaxViewsPerBatch);
+  // The resolve pass reads the batch's keys as one texel buffer.
+  const std::size_t by_texels = impl_->ctx.device().max_texel_buffer_elements / pixels;
+  return std::clamp<std::size_t>(std::min({by_range, by_budget, by_texels, kMaxViewsPerBatch}), 1, kMaxViewsPerBatch);
 }
 
 std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses) {
@@ -261,7 +273,7 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
   auto& m = *impl_;
   auto& w = *m.workspace;
   const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
-  if (pixels * 16 > m.ctx.device().max_storage_buffer_range)
+  if (pixels * 16 > m.ctx.device().max_storage_buffer_range || pixels > m.ctx.device().max_texel_buffer_elements)
     throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
   const std::size_t per_batch = viewsPerBatch(camera);
   const RasterPush push{camera.floatIntrinsics(), camera.width, camera.height, m.face_count, m.flags};
