@@ -44,10 +44,10 @@ void main() {
   int h = t * kHeaderInts;
   // This template's own range of positions (match::coarseRange): first column and row,
   // columns, rows; with pruning, clipped to its depth band's box (match::clipToBox).
-  int c_lo = headers[h + 2], r_lo = headers[h + 3], columns = headers[h + 5], rows = headers[h + 6];
-  int anchor_dc = headers[h + 7], anchor_dr = headers[h + 8], z_lo = headers[h + 9], z_hi = headers[h + 10];
+  int c_lo = header(h + 2), r_lo = header(h + 3), columns = header(h + 5), rows = header(h + 6);
+  int anchor_dc = header(h + 7), anchor_dr = header(h + 8), z_lo = header(h + 9), z_hi = header(h + 10);
   if (pc.cells_x != 0) {
-    int b = pc.boxes_at + 4 * headers[h + 11];
+    int b = pc.boxes_at + 4 * header(h + 11);
     ivec4 box = ivec4(texelFetch(depth_cells, b).x, texelFetch(depth_cells, b + 1).x, texelFetch(depth_cells, b + 2).x,
                       texelFetch(depth_cells, b + 3).x);
     int r_hi = min(r_lo + rows, box.y - anchor_dr), c_hi = min(c_lo + columns, box.w - anchor_dc);
@@ -63,7 +63,7 @@ void main() {
   int span = idx - band * spans;
   int r0 = r_lo + band * kCoarseRows;
   int c0 = c_lo + span * 16 * SPAN;
-  int f = headers[h], end = f + headers[h + 1];
+  int f = header(h), end = f + header(h + 1);
   // A strip that cannot pass reads no memory: no features to add (llvmpipe skips the loop
   // when none of a vector's lanes enters it).
   if (!stripMayPass(r0 + anchor_dr, c0 + anchor_dc, min(16 * SPAN, columns - span * 16 * SPAN), z_lo, z_hi)) end = f;
@@ -84,7 +84,7 @@ void main() {
     }
     for (int i = 0; i < kCoarseRows * SPAN; ++i) widenSplit(acc[i], lo[i], hi[i]);
   }
-  uint threshold = uint(headers[h + 4]);
+  uint threshold = uint(header(h + 4));
   // Few positions pass. llvmpipe runs both sides of every `if` under a lane mask, so the
   // appending below (an atomic is a loop over the lanes) would cost every invocation;
   // a loop whose count is 0 unless some position passes is skipped when no lane enters it.

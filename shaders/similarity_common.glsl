@@ -67,4 +67,7 @@ void widenSplit(uvec4 acc, inout uvec4 lo, inout uvec4 hi) {
 // threshold, then the coarse level's columns and rows of positions (match::coarseRange),
 // the depth gate (match::TemplateDepthGate: anchor cell column and row offsets, least and
 // greatest depth in mm), unused.
-layout(std430, binding = 1) readonly buffer Templates { int headers[]; };
+// A texel buffer: the header's words are read at the workgroup's template, which lavapipe's
+// storage-buffer loads would fetch lane by lane.
+layout(binding = 1) uniform itextureBuffer header_texels;
+int header(int i) { return texelFetch(header_texels, i).x; }

@@ -23,7 +23,7 @@ void main() {
   int row = (int(run.x) - t * pc.grid.bands) * kUnitBand - pc.grid.pad;
   int column = int(run.y) - pc.grid.pad;
   int h = t * kHeaderInts;
-  int f = headers[h], end = f + headers[h + 1];
+  int f = header(h), end = f + header(h + 1);
   uint base = uint(row * pc.stride + column);
   int row_texels = pc.stride / 32;
   uvec4 lo[kUnitBand * SPAN], hi[kUnitBand * SPAN];

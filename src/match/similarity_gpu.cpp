@@ -82,12 +82,13 @@ struct Similarity::Kernels {
       refine.push_back(std::make_unique<Kernel>(c, ShaderId::similarity_refine, 6, sizeof(RefinePush),
                                                 std::vector<uint32_t>{span}, kMemoryAndOffsets));
   }
-  // Linear memory and feature offsets are read as texel buffers (similarity_common.glsl).
-  static inline const std::vector<TexelBinding> kMemoryAndOffsets{{0, vk::Format::eR32G32B32A32Uint},
-                                                                  {2, vk::Format::eR32Sint}};
+  // Linear memory, template headers and feature offsets are read as texel buffers
+  // (similarity_common.glsl).
+  static inline const std::vector<TexelBinding> kMemoryAndOffsets{
+      {0, vk::Format::eR32G32B32A32Uint}, {1, vk::Format::eR32Sint}, {2, vk::Format::eR32Sint}};
   // The coarse pass also reads the frame's anchor cells (depth-guided pruning) as r32ui.
   static inline const std::vector<TexelBinding> kCoarseTexels{kMemoryAndOffsets[0], kMemoryAndOffsets[1],
-                                                              {4, vk::Format::eR32Uint}};
+                                                              kMemoryAndOffsets[2], {4, vk::Format::eR32Uint}};
   Kernel coarse, mark, units, args;
   std::vector<std::unique_ptr<Kernel>> refine;  // per run length (specialization constant SPAN)
   Kernel select;
