@@ -9,38 +9,13 @@ layout(binding = 0) uniform utextureBuffer cells;    // rg32ui: depth in 0.1 mm,
 layout(binding = 1) uniform utextureBuffer members;  // rgba32ui, 4 texels per member
 layout(binding = 2) uniform utextureBuffer depth;    // r32ui: float metres, row-major
 layout(std430, binding = 3) buffer Scores { uvec4 scores[]; };  // 2 per member
+// The scene's normal at each pixel, computed once a frame by scene_normals.comp (sceneNormal's
+// result: x, y, z as float bits, w 1 where there is one); per member cell it cost five depth
+// fetches and a cross product.
+layout(binding = 4) uniform utextureBuffer scene_normals;
 layout(push_constant) uniform ScorePushBlock { ScorePush pc; };
 
-float sceneDepth(int x, int y) {
-  if (x < 0 || y < 0 || x >= pc.width || y >= pc.height) return 0.0;
-  return uintBitsToFloat(texelFetch(depth, y * pc.width + x).x);
-}
-
-vec3 backProject(int u, int v, float d) {
-  return vec3((float(u) - pc.camera.cx) * (1.0 / pc.camera.fx) * d, (float(v) - pc.camera.cy) * (1.0 / pc.camera.fy) * d,
-              d);
-}
-
-bool sceneNormal(int x, int y, out vec3 n) {
-  int s = pc.normal_step;
-  float z = sceneDepth(x, y);
-  float zl = sceneDepth(x - s, y), zr = sceneDepth(x + s, y);
-  float zu = sceneDepth(x, y - s), zd = sceneDepth(x, y + s);
-  n = vec3(0.0);
-  if (z <= 0.0 || zl <= 0.0 || zr <= 0.0 || zu <= 0.0 || zd <= 0.0) return false;
-  if (abs(zl - z) > pc.max_jump || abs(zr - z) > pc.max_jump || abs(zu - z) > pc.max_jump ||
-      abs(zd - z) > pc.max_jump)
-    return false;
-  precise vec3 dx = backProject(x + s, y, zr) - backProject(x - s, y, zl);
-  precise vec3 dy = backProject(x, y + s, zd) - backProject(x, y - s, zu);
-  precise vec3 c = cross(dx, dy);
-  precise float len = sqrt(dot(c, c));
-  if (!(len > 0.0)) return false;
-  c = c / len;
-  if (dot(c, backProject(x, y, z)) > 0.0) c = -c;
-  n = c;
-  return true;
-}
+#include "scene_normal.glsl"
 
 vec3 cellNormal(uint packed) {
   return vec3(float(bitfieldExtract(int(packed), 0, 8)), float(bitfieldExtract(int(packed), 8, 8)),
@@ -83,8 +58,9 @@ void main() {
         float ds = sceneDepth(x, y);
         if (ds <= 0.0) continue;
         error_sum += min(abs(ds - float(cell.x) * 1e-4 - offset), pc.depth_cap);
-        vec3 ns;
-        if (!sceneNormal(x, y, ns)) continue;
+        const uvec4 scene_normal = texelFetch(scene_normals, y * pc.width + x);
+        if (scene_normal.w == 0u) continue;
+        const vec3 ns = uintBitsToFloat(scene_normal.xyz);
         vec3 nt = normalize(ray * cellNormal(cell.y));
         angle_sum += acos(clamp(dot(nt, ns), -1.0, 1.0));
         ++normal_pairs;

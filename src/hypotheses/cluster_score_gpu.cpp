@@ -1,6 +1,7 @@
 // Stage 4 on the GPU: the crops of every scored member, one record per member and the
-// scene depth go up in one batch; shaders/cluster_score.comp scores each member in one
-// invocation; the member scores come back and are combined on the CPU.
+// scene depth go up in one batch; shaders/scene_normals.comp computes the scene's normals
+// once, shaders/cluster_score.comp scores each member in one invocation; the member scores
+// come back and are combined on the CPU.
 #include <bit>
 #include <cstring>
 #include <unordered_map>
@@ -16,11 +17,15 @@ class ClusterScoreKernels {
  public:
   explicit ClusterScoreKernels(const GpuContext& c)
       : ctx(c),
-        kernel(c, ShaderId::cluster_score, 4, sizeof(ScorePush), {},
-               {{0, vk::Format::eR32G32Uint}, {1, vk::Format::eR32G32B32A32Uint}, {2, vk::Format::eR32Uint}}) {}
+        normals(c, ShaderId::scene_normals, 2, sizeof(ScorePush), {}, {{0, vk::Format::eR32Uint}}),
+        kernel(c, ShaderId::cluster_score, 5, sizeof(ScorePush), {},
+               {{0, vk::Format::eR32G32Uint},
+                {1, vk::Format::eR32G32B32A32Uint},
+                {2, vk::Format::eR32Uint},
+                {4, vk::Format::eR32G32B32A32Uint}}) {}
   const GpuContext& ctx;
-  Kernel kernel;
-  Buffer cells, members, depth, scores;
+  Kernel normals, kernel;
+  Buffer cells, members, depth, scene_normals, scores;
 };
 
 }  // namespace gpu
@@ -79,6 +84,7 @@ void ClusterScorer::scoreMembers(std::vector<Hypothesis>& hypotheses, const std:
   g.cells.reserve(g.ctx, cells.size() * 4);
   g.members.reserve(g.ctx, records.size() * 4);
   g.depth.reserve(g.ctx, depth.total() * 4);
+  g.scene_normals.reserve(g.ctx, depth.total() * 16);
   g.scores.reserve(g.ctx, member_count * 32);
   gpu::Batch batch(g.ctx);
   batch.upload(g.cells, cells.data(), cells.size() * 4);
@@ -86,8 +92,11 @@ void ClusterScorer::scoreMembers(std::vector<Hypothesis>& hypotheses, const std:
   batch.upload(g.depth, depth.data, depth.total() * 4);
   const gpu::ScorePush push{scene.camera.floatIntrinsics(), depth.cols, depth.rows, static_cast<uint32_t>(member_count),
                             params.normal_step_px, params.normal_max_jump_m, params.depth_cap_m};
+  // The scene's normals once for all members (scene_normals.comp), then the members.
+  const auto pixel_groups = gpu::groups2DFor(depth.total(), gpu::kWorkgroupSize);
+  batch.dispatch(g.normals, {g.depth, g.scene_normals}, push, pixel_groups.x, pixel_groups.y);
   const auto groups = gpu::groups2DFor(member_count, gpu::kWorkgroupSize);
-  batch.dispatch(g.kernel, {g.cells, g.members, g.depth, g.scores}, push, groups.x, groups.y);
+  batch.dispatch(g.kernel, {g.cells, g.members, g.depth, g.scores, g.scene_normals}, push, groups.x, groups.y);
   std::vector<uint32_t> out(member_count * 8);
   batch.download(g.scores, out.data(), out.size() * 4);
   batch.submit();
