@@ -30,6 +30,10 @@ void main() {
     colour_out[o] = 0u;
     return;
   }
+  if ((pc.flags & kRasterDepthOnly) != 0u) {  // no triangle to set up again
+    depth_out[o] = uintBitsToFloat(uint(key >> 32));
+    return;
+  }
   uint f = uint(key & 0xFFFFFFFFul);
   int y = int(i) / pc.width, x = int(i) - y * pc.width;
   precise float z = uintBitsToFloat(uint(key >> 32));

@@ -152,12 +152,13 @@ const float kGuardPx = 1048576.0f;  // screen coordinates beyond this are droppe
 // RasterPush::flags
 const uint kRasterVertexNormals = 1u;
 const uint kRasterVertexColours = 2u;
+const uint kRasterDepthOnly = 4u;  // the resolve pass writes depth alone (from pass 1's keys)
 
 struct RasterPush {
   FloatIntrinsics camera;
   int width, height;
   uint face_count;
-  uint flags;  // kRasterVertexNormals | kRasterVertexColours
+  uint flags;  // kRasterVertexNormals | kRasterVertexColours | kRasterDepthOnly
 };
 
 #ifdef __cplusplus

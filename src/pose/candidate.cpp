@@ -129,15 +129,17 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
                   const PoseFrame& frame, const DetectorParams& params) {
   const Camera& camera = frame.camera;
   const std::size_t n = candidates.size();
-  // Rendering is the GPU's, one submit a candidate in the calling thread; the translations
-  // run in parallel.
+  // Rendering is the GPU's, one submit a candidate in the calling thread, depth alone (all
+  // initialTranslation reads); the translations run in parallel.
   std::vector<Rendering> renderings(n);
   std::vector<cv::Rect> windows(n);
   for (std::size_t i = 0; i < n; ++i) {
     const PoseObject& o = objects[candidates[i].bank()];
     windows[i] = projectedWindow(candidates[i].start, o.bank->centre, o.bounding_radius, camera);
     if (windows[i].empty()) continue;  // initialTranslation says why
-    renderings[i] = std::move(o.renderer->render(windowCamera(camera, windows[i]), {candidates[i].start}).front());
+    renderings[i] =
+        std::move(o.renderer->render(windowCamera(camera, windows[i]), {candidates[i].start}, RenderedImages::depth)
+                      .front());
   }
   util::parallelFor(
       n,

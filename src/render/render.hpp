@@ -41,6 +41,9 @@ Rendering rotateInPlane(const Rendering& r, float degrees, double cx, double cy)
 struct RenderWorkspace;
 std::shared_ptr<RenderWorkspace> makeRenderWorkspace(const GpuContext& ctx);
 
+/// What MeshRenderer::render fills in each Rendering.
+enum class RenderedImages { all, depth };
+
 class MeshRenderer {
  public:
   /// Without `workspace` the renderer has one of its own; with it, the caller promises that
@@ -50,7 +53,10 @@ class MeshRenderer {
   MeshRenderer(const MeshRenderer&) = delete;
   MeshRenderer& operator=(const MeshRenderer&) = delete;
 
-  std::vector<Rendering> render(const Camera& camera, const std::vector<Pose>& poses);
+  /// `images`: RenderedImages::depth leaves each rendering's normals and colours empty, and
+  /// costs the resolve pass nearly nothing (its depth is pass 1's).
+  std::vector<Rendering> render(const Camera& camera, const std::vector<Pose>& poses,
+                                RenderedImages images = RenderedImages::all);
   /// Views that render per submit at this image size.
   std::size_t viewsPerBatch(const Camera& camera) const;
 

@@ -268,7 +268,8 @@ std::size_t MeshRenderer::viewsPerBatch(const Camera& camera) const {
   return std::clamp<std::size_t>(std::min({by_range, by_budget, by_texels, kMaxViewsPerBatch}), 1, kMaxViewsPerBatch);
 }
 
-std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses) {
+std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses,
+                                            RenderedImages images) {
   validateCamera(camera, "render camera");
   auto& m = *impl_;
   auto& w = *m.workspace;
@@ -276,7 +277,9 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
   if (pixels * 16 > m.ctx.device().max_storage_buffer_range || pixels > m.ctx.device().max_texel_buffer_elements)
     throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
   const std::size_t per_batch = viewsPerBatch(camera);
-  const RasterPush push{camera.floatIntrinsics(), camera.width, camera.height, m.face_count, m.flags};
+  const bool depth_only = images == RenderedImages::depth;
+  const RasterPush push{camera.floatIntrinsics(), camera.width, camera.height, m.face_count,
+                        m.flags | (depth_only ? gpu::kRasterDepthOnly : 0u)};
   const uint32_t face_groups = gpu::groupsFor(m.face_count, gpu::kWorkgroupSize);
   std::vector<Rendering> out;
   out.reserve(poses.size());
@@ -294,8 +297,8 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     w.normal_out.reserve(m.ctx, n * pixels * 16);
     w.colour_out.reserve(m.ctx, n * pixels * 4);
     depth.resize(n * pixels);
-    normals.resize(n * pixels * 4);
-    colour.resize(n * pixels);
+    normals.resize(depth_only ? 0 : n * pixels * 4);
+    colour.resize(depth_only ? 0 : n * pixels);
     gpu::Batch& batch = m.batch;
     batch.upload(w.poses, rows.data(), rows.size() * 4);
     batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
@@ -308,12 +311,18 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
                    {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
                    push, gpu::groupsFor(pixels, gpu::kWorkgroupSize), static_cast<uint32_t>(n));
     batch.download(w.depth, depth.data(), n * pixels * 4);
-    batch.download(w.normal_out, normals.data(), n * pixels * 16);
-    batch.download(w.colour_out, colour.data(), n * pixels * 4);
+    if (!depth_only) {
+      batch.download(w.normal_out, normals.data(), n * pixels * 16);
+      batch.download(w.colour_out, colour.data(), n * pixels * 4);
+    }
     batch.submit();
     for (std::size_t v = 0; v < n; ++v) {
       Rendering r;
       r.depth = cv::Mat(camera.height, camera.width, CV_32FC1, depth.data() + v * pixels).clone();
+      if (depth_only) {
+        out.push_back(std::move(r));
+        continue;
+      }
       cv::Mat n4(camera.height, camera.width, CV_32FC4, normals.data() + v * pixels * 4);
       cv::cvtColor(n4, r.normals, cv::COLOR_BGRA2BGR);
       cv::Mat c4(camera.height, camera.width, CV_8UC4, colour.data() + v * pixels);

@@ -2,6 +2,7 @@
 // shapes, and the orientation of the image (no mirrored or flipped renderings).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include <gtest/gtest.h>
@@ -104,6 +105,29 @@ TEST(Render, GpuMatchesReferenceOnTheCoffeeCupAndAColouredPly) {
       EXPECT_LE(g.max_colour, 2) << file << " view " << i;
     }
   }
+}
+
+TEST(Render, DepthAloneIsTheFullRenderingsDepthBitForBit) {
+  // Stage 6 renders depth alone (RenderedImages::depth): the resolve pass then writes pass 1's
+  // depth without setting up the triangle again, and must give the same floats.
+  const Mesh mesh = test::meshOrStandIn("lmo_scene2_frame3/models/obj_000005.ply");
+  MeshRenderer renderer(test::context(), mesh);
+  const Camera cam = smallCamera();
+  const std::vector<Pose> poses = {viewPose({0.3f, -0.5f, 0.8f}, 0.6f, 20.f, mesh.bboxCentre()),
+                                   viewPose({-0.7f, 0.2f, 0.3f}, 0.9f, -40.f, mesh.bboxCentre())};
+  const auto full = renderer.render(cam, poses);
+  const auto depth = renderer.render(cam, poses, RenderedImages::depth);
+  ASSERT_EQ(depth.size(), poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    ASSERT_GT(cv::countNonZero(full[i].mask()), 1000);
+    EXPECT_EQ(std::memcmp(full[i].depth.data, depth[i].depth.data, full[i].depth.total() * sizeof(float)), 0)
+        << "view " << i;
+    EXPECT_TRUE(depth[i].normals.empty());
+    EXPECT_TRUE(depth[i].bgr.empty());
+  }
+  // And a full rendering after a depth-only one is whole again.
+  const auto again = renderer.render(cam, {poses[0]});
+  EXPECT_EQ(cv::countNonZero(again[0].bgr.reshape(1) != full[0].bgr.reshape(1)), 0);
 }
 
 // The rasterizer's edge functions run in 32 bits for triangles under 2,048 px across and in
