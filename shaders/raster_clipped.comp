@@ -13,6 +13,7 @@ layout(std430, binding = 3) buffer Raster { uint64_t raster[]; };
 void main() {
   uint f = gl_GlobalInvocationID.x;
   uint view = gl_WorkGroupID.y;
+  usePrincipalPointOf(view);
   if (f >= pc.face_count) return;
   ClippedFace c;
   if (!clipFace(view, f, c)) return;

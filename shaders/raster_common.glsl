@@ -11,8 +11,14 @@ layout(binding = 0) uniform utextureBuffer vertex_texels;  // x, y, z as float b
 layout(binding = 1) uniform utextureBuffer face_texels;    // corner indices a, b, c, 0
 vec3 vertexAt(uint v) { return uintBitsToFloat(texelFetch(vertex_texels, int(v)).xyz); }
 uvec4 faceAt(uint f) { return texelFetch(face_texels, int(f)); }
-layout(binding = 2) uniform utextureBuffer pose_texels;   // 3 rows (R | t) per view, float bits
-vec4 poseRow(uint i) { return uintBitsToFloat(texelFetch(pose_texels, int(i))); }
+// Per view 4 texels: the rows of R | t, then the view's principal point (cx, cy): views of one
+// batch may each see through their own window of a frame (MeshRenderer::render's cameras).
+layout(binding = 2) uniform utextureBuffer pose_texels;
+vec4 poseRow(uint view, uint row) { return uintBitsToFloat(texelFetch(pose_texels, int(4u * view + row))); }
+
+// The principal point of the view this invocation renders: each kernel's main() sets it first.
+vec2 principal;
+void usePrincipalPointOf(uint view) { principal = poseRow(view, 3u).xy; }
 
 layout(push_constant) uniform RasterPushBlock { RasterPush pc; };
 
@@ -36,7 +42,7 @@ struct Triangle {
 };
 
 vec3 toCamera(uint view, vec3 v) {
-  vec4 r0 = poseRow(3u * view), r1 = poseRow(3u * view + 1u), r2 = poseRow(3u * view + 2u);
+  vec4 r0 = poseRow(view, 0u), r1 = poseRow(view, 1u), r2 = poseRow(view, 2u);
   precise vec3 c = vec3(dot(r0.xyz, v) + r0.w, dot(r1.xyz, v) + r1.w, dot(r2.xyz, v) + r2.w);
   return c;
 }
@@ -55,8 +61,8 @@ float edgeFunction(bool wide, ivec2 a, ivec2 b, ivec2 p) {
 // the outputs mean nothing). Triangles and clipped faces round their corners alike.
 bool projectPoint(vec3 p, out float rz_out, out ivec2 s) {
   precise float rz = 1.0 / p.z;
-  precise float sx = pc.camera.fx * (p.x * rz) + pc.camera.cx;
-  precise float sy = pc.camera.fy * (p.y * rz) + pc.camera.cy;
+  precise float sx = pc.camera.fx * (p.x * rz) + principal.x;
+  precise float sy = pc.camera.fy * (p.y * rz) + principal.y;
   rz_out = rz;
   s = ivec2(floor(sx * kSubpixel + 0.5), floor(sy * kSubpixel + 0.5));
   return abs(sx) < kGuardPx && abs(sy) < kGuardPx;
@@ -123,8 +129,8 @@ vec3 edgesAt(Triangle t, int x, int y) {
 // snapping that decides coverage; clamped to the face's own depth range for grazing faces
 // whose plane is nearly parallel to the ray.
 float planeDepthAt(vec3 n, float n_p0, vec2 zrange, int x, int y) {
-  precise vec3 ray = vec3((float(x) - pc.camera.cx) * (1.0 / pc.camera.fx),
-                          (float(y) - pc.camera.cy) * (1.0 / pc.camera.fy), 1.0);
+  precise vec3 ray = vec3((float(x) - principal.x) * (1.0 / pc.camera.fx),
+                          (float(y) - principal.y) * (1.0 / pc.camera.fy), 1.0);
   precise float denom = dot(n, ray);
   precise float z = denom != 0.0 ? n_p0 * (1.0 / denom) : zrange.y;
   return clamp(z, zrange.x, zrange.y);

@@ -19,6 +19,7 @@ uint packChannel(float c) { return uint(clamp(c, 0.0, 1.0) * 255.0 + 0.5); }
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint view = gl_WorkGroupID.y;
+  usePrincipalPointOf(view);
   uint pixels = uint(pc.width * pc.height);
   if (i >= pixels) return;
   uint o = view * pixels + i;
@@ -47,20 +48,20 @@ void main() {
     face_n = t.n;
   } else {
     // A clipped face (raster_depth.comp): weights from its corners in the camera frame.
-    precise vec3 point = vec3((float(x) - pc.camera.cx) * (1.0 / pc.camera.fx),
-                              (float(y) - pc.camera.cy) * (1.0 / pc.camera.fy), 1.0) * z;
+    precise vec3 point = vec3((float(x) - principal.x) * (1.0 / pc.camera.fx),
+                              (float(y) - principal.y) * (1.0 / pc.camera.fy), 1.0) * z;
     w = faceWeights(view, f, point, face_n);
   }
   uvec4 idx = faceAt(f);
   precise vec3 n;
   if ((pc.flags & kRasterVertexNormals) != 0u) {
     precise vec3 m = w.x * vertexNormal(idx.x) + w.y * vertexNormal(idx.y) + w.z * vertexNormal(idx.z);
-    vec4 r0 = poseRow(3u * view), r1 = poseRow(3u * view + 1u), r2 = poseRow(3u * view + 2u);
+    vec4 r0 = poseRow(view, 0u), r1 = poseRow(view, 1u), r2 = poseRow(view, 2u);
     n = vec3(dot(r0.xyz, m), dot(r1.xyz, m), dot(r2.xyz, m));
   } else {
     n = face_n;
   }
-  precise vec3 ray = vec3((float(x) - pc.camera.cx) / pc.camera.fx, (float(y) - pc.camera.cy) / pc.camera.fy, 1.0);
+  precise vec3 ray = vec3((float(x) - principal.x) / pc.camera.fx, (float(y) - principal.y) / pc.camera.fy, 1.0);
   precise float len2 = dot(n, n);
   if (len2 > 0.0) n = n * (1.0 / sqrt(len2));
   if (dot(n, ray) > 0.0) n = -n;

@@ -129,17 +129,28 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
                   const PoseFrame& frame, const DetectorParams& params) {
   const Camera& camera = frame.camera;
   const std::size_t n = candidates.size();
-  // Rendering is the GPU's, one submit a candidate in the calling thread, depth alone (all
-  // initialTranslation reads); the translations run in parallel.
+  // Rendering is the GPU's, in the calling thread: every start of an object in one call, each
+  // in its own window, depth alone (all initialTranslation reads); the translations run in
+  // parallel.
   std::vector<Rendering> renderings(n);
   std::vector<cv::Rect> windows(n);
   for (std::size_t i = 0; i < n; ++i) {
     const PoseObject& o = objects[candidates[i].bank()];
     windows[i] = projectedWindow(candidates[i].start, o.bank->centre, o.bounding_radius, camera);
-    if (windows[i].empty()) continue;  // initialTranslation says why
-    renderings[i] =
-        std::move(o.renderer->render(windowCamera(camera, windows[i]), {candidates[i].start}, RenderedImages::depth)
-                      .front());
+  }
+  for (std::size_t b = 0; b < objects.size(); ++b) {
+    std::vector<std::size_t> ids;  // empty windows: initialTranslation says why
+    std::vector<Camera> cameras;
+    std::vector<Pose> starts;
+    for (std::size_t i = 0; i < n; ++i)
+      if (candidates[i].bank() == b && !windows[i].empty()) {
+        ids.push_back(i);
+        cameras.push_back(windowCamera(camera, windows[i]));
+        starts.push_back(candidates[i].start);
+      }
+    if (ids.empty()) continue;
+    std::vector<Rendering> rendered = objects[b].renderer->render(cameras, starts, RenderedImages::depth);
+    for (std::size_t k = 0; k < ids.size(); ++k) renderings[ids[k]] = std::move(rendered[k]);
   }
   util::parallelFor(
       n,

@@ -57,6 +57,11 @@ class MeshRenderer {
   /// costs the resolve pass nearly nothing (its depth is pass 1's).
   std::vector<Rendering> render(const Camera& camera, const std::vector<Pose>& poses,
                                 RenderedImages images = RenderedImages::all);
+  /// Pose i as cameras[i] sees it (its size and principal point; every camera of the call of
+  /// one focal length, as the windows of one frame are): one submit for a batch of views
+  /// where a render() each costs a submit each, the same pixels.
+  std::vector<Rendering> render(const std::vector<Camera>& cameras, const std::vector<Pose>& poses,
+                                RenderedImages images = RenderedImages::all);
   /// Views that render per submit at this image size.
   std::size_t viewsPerBatch(const Camera& camera) const;
 

@@ -270,15 +270,56 @@ std::size_t MeshRenderer::viewsPerBatch(const Camera& camera) const {
 
 std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vector<Pose>& poses,
                                             RenderedImages images) {
-  validateCamera(camera, "render camera");
+  return render(std::vector<Camera>(poses.size(), camera), poses, images);
+}
+
+namespace {
+
+/// The image all of a batch's views render into: as large as the largest camera's; each
+/// view's rendering is its top-left corner. The cameras must share their focal lengths (the
+/// kernels take them from the push constants, each view's principal point from its pose).
+Camera canvasFor(const std::vector<Camera>& cameras) {
+  Camera canvas = cameras.front();
+  for (const Camera& c : cameras) {
+    validateCamera(c, "render camera");
+    if (c.fx != canvas.fx || c.fy != canvas.fy)
+      throw std::logic_error("MeshRenderer::render: the cameras of one call need the same focal lengths");
+    canvas.width = std::max(canvas.width, c.width);
+    canvas.height = std::max(canvas.height, c.height);
+  }
+  return canvas;
+}
+
+/// View v's rendering out of a batch's downloads on the canvas.
+Rendering unpackView(std::size_t v, const Camera& canvas, const Camera& camera, std::vector<float>& depth,
+                     std::vector<float>& normals, std::vector<uint32_t>& colour) {
+  const std::size_t pixels = static_cast<std::size_t>(canvas.width) * canvas.height;
+  const cv::Rect own(0, 0, camera.width, camera.height);
+  Rendering r;
+  r.depth = cv::Mat(canvas.height, canvas.width, CV_32FC1, depth.data() + v * pixels)(own).clone();
+  if (normals.empty()) return r;  // depth alone
+  cv::Mat n4(canvas.height, canvas.width, CV_32FC4, normals.data() + v * pixels * 4);
+  cv::cvtColor(n4(own), r.normals, cv::COLOR_BGRA2BGR);
+  cv::Mat c4(canvas.height, canvas.width, CV_8UC4, colour.data() + v * pixels);
+  cv::cvtColor(c4(own), r.bgr, cv::COLOR_BGRA2BGR);
+  return r;
+}
+
+}  // namespace
+
+std::vector<Rendering> MeshRenderer::render(const std::vector<Camera>& cameras, const std::vector<Pose>& poses,
+                                            RenderedImages images) {
+  if (cameras.size() != poses.size()) throw std::logic_error("MeshRenderer::render: a camera per pose");
+  if (poses.empty()) return {};
+  const Camera canvas = canvasFor(cameras);
   auto& m = *impl_;
   auto& w = *m.workspace;
-  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  const std::size_t pixels = static_cast<std::size_t>(canvas.width) * canvas.height;
   if (pixels * 16 > m.ctx.device().max_storage_buffer_range || pixels > m.ctx.device().max_texel_buffer_elements)
-    throw InputError(fmt::format("render size {}x{} is too large for one device buffer", camera.width, camera.height));
-  const std::size_t per_batch = viewsPerBatch(camera);
+    throw InputError(fmt::format("render size {}x{} is too large for one device buffer", canvas.width, canvas.height));
+  const std::size_t per_batch = viewsPerBatch(canvas);
   const bool depth_only = images == RenderedImages::depth;
-  const RasterPush push{camera.floatIntrinsics(), camera.width, camera.height, m.face_count,
+  const RasterPush push{canvas.floatIntrinsics(), canvas.width, canvas.height, m.face_count,
                         m.flags | (depth_only ? gpu::kRasterDepthOnly : 0u)};
   const uint32_t face_groups = gpu::groupsFor(m.face_count, gpu::kWorkgroupSize);
   std::vector<Rendering> out;
@@ -287,10 +328,13 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
   std::vector<uint32_t> colour;
   for (std::size_t first = 0; first < poses.size(); first += per_batch) {
     const std::size_t n = std::min(per_batch, poses.size() - first);
-    std::vector<float> rows;
-    for (std::size_t v = first; v < first + n; ++v)
+    std::vector<float> rows;  // per view R | t, then the principal point (raster_common.glsl)
+    for (std::size_t v = first; v < first + n; ++v) {
       for (int r = 0; r < 3; ++r)
         rows.insert(rows.end(), {poses[v].R(r, 0), poses[v].R(r, 1), poses[v].R(r, 2), poses[v].t(r)});
+      const FloatIntrinsics k = cameras[v].floatIntrinsics();
+      rows.insert(rows.end(), {k.cx, k.cy, 0.f, 0.f});
+    }
     w.poses.reserve(m.ctx, rows.size() * 4);
     w.keys.reserve(m.ctx, n * pixels * 8);
     w.depth.reserve(m.ctx, n * pixels * 4);
@@ -303,10 +347,10 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
     batch.upload(w.poses, rows.data(), rows.size() * 4);
     batch.fill(w.keys, 0xFFFFFFFFu, n * pixels * 8);
     batch.dispatch(m.raster, {m.vertices, m.faces, w.poses, w.keys}, push, face_groups,
-                   static_cast<uint32_t>(n), rasterBands(camera));
+                   static_cast<uint32_t>(n), rasterBands(canvas));
     if (m.reachesPastTheCamera(poses, first, n))
       batch.dispatch(m.clipped, {m.vertices, m.faces, w.poses, w.keys}, push, face_groups,
-                     static_cast<uint32_t>(n), rasterBands(camera));
+                     static_cast<uint32_t>(n), rasterBands(canvas));
     batch.dispatch(m.resolve,
                    {m.vertices, m.faces, w.poses, w.keys, m.normals, m.colours, w.depth, w.normal_out, w.colour_out},
                    push, gpu::groupsFor(pixels, gpu::kWorkgroupSize), static_cast<uint32_t>(n));
@@ -316,19 +360,7 @@ std::vector<Rendering> MeshRenderer::render(const Camera& camera, const std::vec
       batch.download(w.colour_out, colour.data(), n * pixels * 4);
     }
     batch.submit();
-    for (std::size_t v = 0; v < n; ++v) {
-      Rendering r;
-      r.depth = cv::Mat(camera.height, camera.width, CV_32FC1, depth.data() + v * pixels).clone();
-      if (depth_only) {
-        out.push_back(std::move(r));
-        continue;
-      }
-      cv::Mat n4(camera.height, camera.width, CV_32FC4, normals.data() + v * pixels * 4);
-      cv::cvtColor(n4, r.normals, cv::COLOR_BGRA2BGR);
-      cv::Mat c4(camera.height, camera.width, CV_8UC4, colour.data() + v * pixels);
-      cv::cvtColor(c4, r.bgr, cv::COLOR_BGRA2BGR);
-      out.push_back(std::move(r));
-    }
+    for (std::size_t v = 0; v < n; ++v) out.push_back(unpackView(v, canvas, cameras[first + v], depth, normals, colour));
   }
   return out;
 }
