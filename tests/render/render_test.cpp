@@ -130,6 +130,40 @@ TEST(Render, DepthAloneIsTheFullRenderingsDepthBitForBit) {
   EXPECT_EQ(cv::countNonZero(again[0].bgr.reshape(1) != full[0].bgr.reshape(1)), 0);
 }
 
+TEST(Render, ViewsThroughTheirOwnWindowsInOneCallAreTheViewsRenderedAlone) {
+  // Stage 6 renders each start in its own window of the frame, all of an object's starts in
+  // one call (a camera per pose, the views sharing a canvas as large as the largest window):
+  // each must be the pixels its window's camera renders alone, depth, normals and colours.
+  const Mesh mesh = test::meshOrStandIn("lmo_scene2_frame3/models/obj_000005.ply");
+  MeshRenderer renderer(test::context(), mesh);
+  const Camera frame = smallCamera(320, 240);
+  const auto window = [&](int x, int y, int w, int h) {
+    Camera c = frame;
+    c.cx -= x;
+    c.cy -= y;
+    c.width = w;
+    c.height = h;
+    return c;
+  };
+  const std::vector<Camera> cameras = {window(40, 30, 180, 150), window(100, 60, 120, 110), window(0, 0, 320, 240)};
+  const std::vector<Pose> poses = {viewPose({0.3f, -0.5f, 0.8f}, 0.6f, 20.f, mesh.bboxCentre()),
+                                   viewPose({-0.7f, 0.2f, 0.3f}, 0.9f, -40.f, mesh.bboxCentre()),
+                                   viewPose({0.f, 0.f, 1.f}, 0.7f, 0.f, mesh.bboxCentre())};
+  const auto together = renderer.render(cameras, poses);
+  ASSERT_EQ(together.size(), poses.size());
+  const auto same = [](const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() &&
+           std::memcmp(a.clone().data, b.clone().data, a.total() * a.elemSize()) == 0;
+  };
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Rendering alone = renderer.render(cameras[i], {poses[i]}).front();
+    ASSERT_GT(cv::countNonZero(alone.mask()), 500) << "view " << i;
+    EXPECT_TRUE(same(together[i].depth, alone.depth)) << "view " << i;
+    EXPECT_TRUE(same(together[i].normals, alone.normals)) << "view " << i;
+    EXPECT_TRUE(same(together[i].bgr, alone.bgr)) << "view " << i;
+  }
+}
+
 // The rasterizer's edge functions run in 32 bits for triangles under 2,048 px across and in
 // 64 bits for wider ones (raster_common.glsl); the C++ reference is 64-bit throughout. A 2 m
 // box seen from 2 cm off one face has triangles of tens of thousands of pixels, whose edge
