@@ -62,6 +62,30 @@ void forEachOf(std::vector<PoseCandidate>& candidates, const std::vector<std::si
       threads);
 }
 
+/// Pose i of objects[banks[i]] rendered in windows[i] of the frame (an empty window: left
+/// empty), each object's in one call through a camera per pose: a submit per object and
+/// batch where a render each was a submit each (on LM-O 359 starts), the same pixels.
+std::vector<Rendering> renderInWindows(const std::vector<PoseObject>& objects, const Camera& camera,
+                                       const std::vector<std::size_t>& banks, const std::vector<Pose>& poses,
+                                       const std::vector<cv::Rect>& windows, RenderedImages images) {
+  std::vector<Rendering> out(poses.size());
+  for (std::size_t b = 0; b < objects.size(); ++b) {
+    std::vector<std::size_t> ids;
+    std::vector<Camera> cameras;
+    std::vector<Pose> chosen;
+    for (std::size_t i = 0; i < poses.size(); ++i)
+      if (banks[i] == b && !windows[i].empty()) {
+        ids.push_back(i);
+        cameras.push_back(windowCamera(camera, windows[i]));
+        chosen.push_back(poses[i]);
+      }
+    if (ids.empty()) continue;
+    std::vector<Rendering> rendered = objects[b].renderer->render(cameras, chosen, images);
+    for (std::size_t k = 0; k < ids.size(); ++k) out[ids[k]] = std::move(rendered[k]);
+  }
+  return out;
+}
+
 }  // namespace
 
 PoseFrame poseFrame(const Camera& camera, const cv::Mat& depth_m, const cv::Mat& bgr) {
@@ -129,29 +153,18 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
                   const PoseFrame& frame, const DetectorParams& params) {
   const Camera& camera = frame.camera;
   const std::size_t n = candidates.size();
-  // Rendering is the GPU's, in the calling thread: every start of an object in one call, each
-  // in its own window, depth alone (all initialTranslation reads); the translations run in
-  // parallel.
-  std::vector<Rendering> renderings(n);
+  // Rendering is the GPU's, in the calling thread, depth alone (all initialTranslation reads);
+  // the translations run in parallel. An empty window: initialTranslation says why.
   std::vector<cv::Rect> windows(n);
+  std::vector<std::size_t> banks(n);
+  std::vector<Pose> starts(n);
   for (std::size_t i = 0; i < n; ++i) {
     const PoseObject& o = objects[candidates[i].bank()];
     windows[i] = projectedWindow(candidates[i].start, o.bank->centre, o.bounding_radius, camera);
+    banks[i] = candidates[i].bank();
+    starts[i] = candidates[i].start;
   }
-  for (std::size_t b = 0; b < objects.size(); ++b) {
-    std::vector<std::size_t> ids;  // empty windows: initialTranslation says why
-    std::vector<Camera> cameras;
-    std::vector<Pose> starts;
-    for (std::size_t i = 0; i < n; ++i)
-      if (candidates[i].bank() == b && !windows[i].empty()) {
-        ids.push_back(i);
-        cameras.push_back(windowCamera(camera, windows[i]));
-        starts.push_back(candidates[i].start);
-      }
-    if (ids.empty()) continue;
-    std::vector<Rendering> rendered = objects[b].renderer->render(cameras, starts, RenderedImages::depth);
-    for (std::size_t k = 0; k < ids.size(); ++k) renderings[ids[k]] = std::move(rendered[k]);
-  }
+  std::vector<Rendering> renderings = renderInWindows(objects, camera, banks, starts, windows, RenderedImages::depth);
   util::parallelFor(
       n,
       [&](std::size_t i) {
@@ -246,16 +259,18 @@ void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<P
         c.verify.min_colour_agreement > -1.f)
       which.push_back(i);
   }
-  // Rendering is the GPU's, one small submit a start in the calling thread (as stage 6's).
-  std::vector<Rendering> views(which.size());
+  // Rendering is the GPU's, in the calling thread (as stage 6's).
   std::vector<cv::Rect> windows(which.size());
+  std::vector<std::size_t> banks(which.size());
+  std::vector<Pose> poses(which.size());
   for (std::size_t k = 0; k < which.size(); ++k) {
     const PoseCandidate& c = candidates[which[k]];
     const PoseObject& o = objects[c.bank()];
     windows[k] = projectedWindow(c.first_fit.pose, o.bank->centre, o.bounding_radius, frame.camera);
-    if (!windows[k].empty())
-      views[k] = std::move(o.renderer->render(windowCamera(frame.camera, windows[k]), {c.first_fit.pose}).front());
+    banks[k] = c.bank();
+    poses[k] = c.first_fit.pose;
   }
+  std::vector<Rendering> views = renderInWindows(objects, frame.camera, banks, poses, windows, RenderedImages::all);
   util::parallelFor(
       which.size(),
       [&](std::size_t k) {
