@@ -62,12 +62,22 @@ void forEachOf(std::vector<PoseCandidate>& candidates, const std::vector<std::si
       threads);
 }
 
-/// Pose i of objects[banks[i]] rendered in windows[i] of the frame (an empty window: left
-/// empty), each object's in one call through a camera per pose: a submit per object and
-/// batch where a render each was a submit each (on LM-O 359 starts), the same pixels.
-std::vector<Rendering> renderInWindows(const std::vector<PoseObject>& objects, const Camera& camera,
-                                       const std::vector<std::size_t>& banks, const std::vector<Pose>& poses,
-                                       const std::vector<cv::Rect>& windows, RenderedImages images) {
+/// Pose i of objects[banks[i]] rendered in its own window of the frame (projectedWindow;
+/// an empty window, the model outside the image: an empty rendering), each object's in one
+/// call through a camera per pose: a submit per object and batch where a render each was a
+/// submit each (on LM-O 359 starts), the same pixels.
+struct WindowRenderings {
+  std::vector<Rendering> renderings;
+  std::vector<cv::Rect> windows;
+};
+WindowRenderings renderInWindows(const std::vector<PoseObject>& objects, const Camera& camera,
+                                 const std::vector<std::size_t>& banks, const std::vector<Pose>& poses,
+                                 RenderedImages images) {
+  std::vector<cv::Rect> windows(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const PoseObject& o = objects[banks[i]];
+    windows[i] = projectedWindow(poses[i], o.bank->centre, o.bounding_radius, camera);
+  }
   std::vector<Rendering> out(poses.size());
   for (std::size_t b = 0; b < objects.size(); ++b) {
     std::vector<std::size_t> ids;
@@ -83,7 +93,7 @@ std::vector<Rendering> renderInWindows(const std::vector<PoseObject>& objects, c
     std::vector<Rendering> rendered = objects[b].renderer->render(cameras, chosen, images);
     for (std::size_t k = 0; k < ids.size(); ++k) out[ids[k]] = std::move(rendered[k]);
   }
-  return out;
+  return {std::move(out), std::move(windows)};
 }
 
 }  // namespace
@@ -155,16 +165,13 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
   const std::size_t n = candidates.size();
   // Rendering is the GPU's, in the calling thread, depth alone (all initialTranslation reads);
   // the translations run in parallel. An empty window: initialTranslation says why.
-  std::vector<cv::Rect> windows(n);
   std::vector<std::size_t> banks(n);
   std::vector<Pose> starts(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const PoseObject& o = objects[candidates[i].bank()];
-    windows[i] = projectedWindow(candidates[i].start, o.bank->centre, o.bounding_radius, camera);
     banks[i] = candidates[i].bank();
     starts[i] = candidates[i].start;
   }
-  std::vector<Rendering> renderings = renderInWindows(objects, camera, banks, starts, windows, RenderedImages::depth);
+  auto [renderings, windows] = renderInWindows(objects, camera, banks, starts, RenderedImages::depth);
   util::parallelFor(
       n,
       [&](std::size_t i) {
@@ -260,17 +267,13 @@ void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<P
       which.push_back(i);
   }
   // Rendering is the GPU's, in the calling thread (as stage 6's).
-  std::vector<cv::Rect> windows(which.size());
   std::vector<std::size_t> banks(which.size());
   std::vector<Pose> poses(which.size());
   for (std::size_t k = 0; k < which.size(); ++k) {
-    const PoseCandidate& c = candidates[which[k]];
-    const PoseObject& o = objects[c.bank()];
-    windows[k] = projectedWindow(c.first_fit.pose, o.bank->centre, o.bounding_radius, frame.camera);
-    banks[k] = c.bank();
-    poses[k] = c.first_fit.pose;
+    banks[k] = candidates[which[k]].bank();
+    poses[k] = candidates[which[k]].first_fit.pose;
   }
-  std::vector<Rendering> views = renderInWindows(objects, frame.camera, banks, poses, windows, RenderedImages::all);
+  auto [views, windows] = renderInWindows(objects, frame.camera, banks, poses, RenderedImages::all);
   util::parallelFor(
       which.size(),
       [&](std::size_t k) {

@@ -136,8 +136,8 @@ void firstFits(std::vector<PoseCandidate>& candidates, const PoseFrame& frame, u
 void screenStarts(std::vector<PoseCandidate>& candidates);
 
 /// Stage 7, after screenStarts: each start still going whose mesh has colours and whose
-/// colour test is on (verify.min_colour_agreement > -1) is rendered at its first fit (one
-/// small submit each, in the calling thread) and stops where its colours agree with the
+/// colour test is on (verify.min_colour_agreement > -1) is rendered at its first fit (each
+/// object's starts in one call, in the calling thread) and stops where its colours agree with the
 /// frame's less than stage 8's limit minus RefineParams::first_fit_colour_margin: another
 /// object of the right shape and the wrong colour, which MLS and ICP would not change.
 void firstFitColours(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
