@@ -71,6 +71,27 @@ bool NearestNeighbours::Grid::search(const PointCloud& sorted, const Eigen::Vect
   return false;
 }
 
+void NearestNeighbours::Grid::scanBall(const PointCloud& sorted, const Eigen::Vector3f& q, int& best,
+                                       float& best_sqr) const {
+  const float radius = std::sqrt(best_sqr);
+  const Eigen::Vector3f lo = ((q.array() - radius - origin.array()) * inv_cell).floor().matrix();
+  const Eigen::Vector3f hi = ((q.array() + radius - origin.array()) * inv_cell).floor().matrix();
+  // Clamped to the grid before the casts (q may be anywhere).
+  auto first = [](float v, int n) { return static_cast<int>(std::clamp(v, 0.f, float(n))); };
+  auto last = [](float v, int n) { return static_cast<int>(std::clamp(v, -1.f, float(n - 1))); };
+  const int x0 = first(lo.x(), nx), x1 = last(hi.x(), nx), y0 = first(lo.y(), ny), y1 = last(hi.y(), ny);
+  const int z0 = first(lo.z(), nz), z1 = last(hi.z(), nz);
+  if (x0 > x1) return;
+  for (int z = z0; z <= z1; ++z)
+    for (int y = y0; y <= y1; ++y) {
+      const std::size_t row = (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx);
+      for (std::uint32_t i = start[row + std::size_t(x0)], end = start[row + std::size_t(x1) + 1]; i < end; ++i) {
+        const float d = (sorted[i] - q).squaredNorm();
+        if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
+      }
+    }
+}
+
 NearestNeighbours::NearestNeighbours(const PointCloud& points, float cell, std::size_t max_cells) {
   if (!(cell > 0.f) || !std::isfinite(cell))
     throw InputError(fmt::format("nearest-neighbour grid: the cell size must be positive and finite, got {}", cell));
@@ -79,10 +100,12 @@ NearestNeighbours::NearestNeighbours(const PointCloud& points, float cell, std::
   finite.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
     if (points[i].allFinite()) finite.push_back(points[i]), index.push_back(static_cast<int>(i));
+  sorted_.assign(points.size(), -1);
   if (finite.empty()) return;
   fine_ = Grid(finite, cell, max_cells);
   points_.reserve(finite.size());
   for (const int i : fine_.order) {
+    sorted_[static_cast<std::size_t>(index[static_cast<std::size_t>(i)])] = static_cast<int>(points_.size());
     points_.push_back(finite[static_cast<std::size_t>(i)]);
     original_.push_back(index[static_cast<std::size_t>(i)]);
   }
@@ -118,6 +141,29 @@ int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const 
   }
   dist_sqr = best_sqr;
   return original_[static_cast<std::size_t>(best)];
+}
+
+int NearestNeighbours::nearest(const Eigen::Vector3f& q, int hint, float& dist_sqr) const {
+  const int h = hint >= 0 && static_cast<std::size_t>(hint) < sorted_.size() ? sorted_[static_cast<std::size_t>(hint)] : -1;
+  if (h < 0 || !q.allFinite()) return nearest(q, dist_sqr);
+  // Every point nearer than the hint lies in the ball through it: scan the cells the ball
+  // overlaps, on the fine grid while it spans a few cells, else on the coarse one.
+  float best_sqr = (points_[static_cast<std::size_t>(h)] - q).squaredNorm();
+  const float reach = static_cast<float>(kMaxRing) * fine_.cell;
+  if (best_sqr <= reach * reach) {
+    int best = h;
+    fine_.scanBall(points_, q, best, best_sqr);
+    dist_sqr = best_sqr;
+    return original_[static_cast<std::size_t>(best)];
+  }
+  const float coarse_reach = static_cast<float>(kMaxRing) * coarse_.cell;
+  if (best_sqr <= coarse_reach * coarse_reach) {
+    int best = coarse_rank_[static_cast<std::size_t>(h)];
+    coarse_.scanBall(coarse_sorted_, q, best, best_sqr);
+    dist_sqr = best_sqr;
+    return original_[static_cast<std::size_t>(coarse_.order[static_cast<std::size_t>(best)])];
+  }
+  return nearest(q, dist_sqr);
 }
 
 void NearestNeighbours::within(const Eigen::Vector3f& q, float radius, std::vector<int>& out) const {

@@ -27,6 +27,13 @@ class NearestNeighbours {
   /// every point.
   int nearest(const Eigen::Vector3f& q, float& dist_sqr) const;
 
+  /// nearest(), told a point of the cloud (its input index) that the query was near before.
+  /// ICP asks again for the same model points after each small move: the distance to the last
+  /// answer bounds the new one, so only the cells within it are scanned (about 8 where the
+  /// grid search visits 27 to 125). The same distance as nearest(), and the same point but
+  /// for ties. A hint of -1 (or a non-finite point) is no hint.
+  int nearest(const Eigen::Vector3f& q, int hint, float& dist_sqr) const;
+
   /// Indices of the points within `radius` of q (squared distance <= radius^2), appended to
   /// `out` in no particular order. Scans the fine grid's cells that the ball overlaps, so a
   /// cell about the radius's size suits (MLS's neighbourhoods).
@@ -47,6 +54,9 @@ class NearestNeighbours {
     /// Rings 0..kMaxRing around q; updates best / best_sqr (indices into `order`) and returns
     /// true when no point outside the rings can be nearer.
     bool search(const PointCloud& sorted, const Eigen::Vector3f& q, int& best, float& best_sqr) const;
+    /// Scans the cells that the ball of radius sqrt(best_sqr) around q overlaps; updates best /
+    /// best_sqr (indices into `order`, best may be -1) with any point strictly nearer.
+    void scanBall(const PointCloud& sorted, const Eigen::Vector3f& q, int& best, float& best_sqr) const;
     std::vector<int> order;             // sorted[i] = points[order[i]]
     std::vector<std::uint32_t> start;   // a cell's points are sorted[start[c], start[c + 1])
     Eigen::Vector3f origin = Eigen::Vector3f::Zero();
@@ -56,6 +66,7 @@ class NearestNeighbours {
 
   PointCloud points_;  // the finite points, in the fine grid's order
   std::vector<int> original_;  // points_[i] was points[original_[i]]
+  std::vector<int> sorted_;    // points[i] is points_[sorted_[i]]; -1 for a non-finite point
   Grid fine_, coarse_;         // coarse_ indexes points_ (not the input)
   PointCloud coarse_sorted_;   // points_ in the coarse grid's order
   std::vector<int> coarse_rank_;  // points_[i] is coarse_sorted_[coarse_rank_[i]]

@@ -113,7 +113,10 @@ class AdaptiveIcp {
       : model_(std::move(model)), scene_(std::move(scene)), min_pairs_(min_pairs), nearest_scene_(fromPcl(*scene_), cell) {}
 
   /// The model points the next stages pair (object frame).
-  void setModel(Cloud::ConstPtr model) { model_ = std::move(model); }
+  void setModel(Cloud::ConstPtr model) {
+    model_ = std::move(model);
+    nearest_.clear();
+  }
 
   /// Runs one stage from cam_T_model. Returns true when it converged within the limit;
   /// false when it hit the limit or ran out of pairs (cam_T_model keeps the last pose).
@@ -150,11 +153,12 @@ class AdaptiveIcp {
   /// Returns the threshold.
   float pair(const Eigen::Matrix4f& cam_T_model, float fraction, float fixed = 0.f) {
     pcl::transformPointCloud(*model_, moved_, cam_T_model);
-    nearest_.resize(moved_.size());
+    // The last pairing's scene points are hints for the same model points (setModel clears them).
+    nearest_.resize(moved_.size(), -1);
     dist_sqr_.resize(moved_.size());
     float max_sqr = 0.f;
     for (std::size_t i = 0; i < moved_.size(); ++i) {
-      nearest_[i] = nearest_scene_.nearest(moved_[i].getVector3fMap(), dist_sqr_[i]);
+      nearest_[i] = nearest_scene_.nearest(moved_[i].getVector3fMap(), nearest_[i], dist_sqr_[i]);
       max_sqr = std::max(max_sqr, dist_sqr_[i]);
     }
     const float threshold = fraction > 0.f ? fraction * std::sqrt(max_sqr) : fixed;

@@ -429,6 +429,26 @@ TEST(NearestNeighbours, FindTheSamePointsAsPclsKdTreeAndABruteForceScan) {
     // The far queries need the whole-cloud scan, the near ones never.
     EXPECT_GT(grid.fullScans(), 0u);
     EXPECT_LT(grid.fullScans(), 1000u);
+
+    // With a hint (ICP's last answer for the same model point): the nearest point of the query
+    // before a step of up to 3 mm, any point of the cloud, none, a non-finite or unknown one.
+    std::size_t hinted = 0;
+    for (std::size_t q = 0; q + 1 < queries.size(); ++q) {
+      float before_d = 0.f;
+      const Eigen::Vector3f before = queries[q] + 0.003f * Eigen::Vector3f(uni(rng), uni(rng), uni(rng));
+      const int from_before = grid.nearest(before, before_d);
+      const int any = static_cast<int>(std::uniform_int_distribution<std::size_t>(0, with_bad.size() - 1)(rng));
+      for (const int hint : {from_before, any, -1, 3, static_cast<int>(with_bad.size()) + 5}) {
+        float d = 0.f, plain_d = 0.f;
+        const int found = grid.nearest(queries[q], hint, d);
+        const int plain = grid.nearest(queries[q], plain_d);
+        EXPECT_EQ(d, plain_d) << "query " << q << " hint " << hint;
+        ASSERT_GE(found, 0);
+        EXPECT_EQ((with_bad[static_cast<std::size_t>(found)] - queries[q]).squaredNorm(), d);
+        hinted += found == plain;
+      }
+    }
+    EXPECT_GE(hinted, 5 * (queries.size() - 1) - 10);  // the same point but for ties
   }
   float d = 0.f;
   EXPECT_EQ(NearestNeighbours({}, 0.004f).nearest(Eigen::Vector3f(0.f, 0.f, 1.f), d), -1);
