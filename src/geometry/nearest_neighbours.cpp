@@ -156,14 +156,24 @@ int NearestNeighbours::nearest(const Eigen::Vector3f& q, int hint, float& dist_s
     dist_sqr = best_sqr;
     return original_[static_cast<std::size_t>(best)];
   }
-  const float coarse_reach = static_cast<float>(kMaxRing) * coarse_.cell;
-  if (best_sqr <= coarse_reach * coarse_reach) {
+  // Farther (a model point where the scene is occluded or the pose is wrong, centimetres
+  // off): the coarse grid's cells within the ball, unless the ball spans so many that one
+  // pass over the points costs less.
+  const float across = 2.f * std::sqrt(best_sqr) * coarse_.inv_cell + 2.f;
+  if (across * across * across <= 0.25f * static_cast<float>(points_.size())) {
     int best = coarse_rank_[static_cast<std::size_t>(h)];
     coarse_.scanBall(coarse_sorted_, q, best, best_sqr);
     dist_sqr = best_sqr;
     return original_[static_cast<std::size_t>(coarse_.order[static_cast<std::size_t>(best)])];
   }
-  return nearest(q, dist_sqr);
+  ++full_scans_;
+  int best = h;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    const float d = (points_[i] - q).squaredNorm();
+    if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
+  }
+  dist_sqr = best_sqr;
+  return original_[static_cast<std::size_t>(best)];
 }
 
 void NearestNeighbours::within(const Eigen::Vector3f& q, float radius, std::vector<int>& out) const {
