@@ -1,6 +1,9 @@
 #version 450
 // Stage 2, finer level: for each coarse candidate of this chunk, the best position in its
-// 16 x 16 cell window (first maximum in row-major order), read from the scored units.
+// 16 x 16 cell window (first maximum in row-major order), read from the scored units. Only
+// the candidates whose best passes the match threshold are listed for the host: on a frame
+// of many objects nine coarse candidates in ten fail here, and reading all of them back was
+// most of the matcher's host time.
 #extension GL_EXT_samplerless_texture_functions : require
 #include "packed_scores.glsl"
 #include "refine_grid.glsl"
@@ -10,9 +13,14 @@ layout(binding = 1) uniform utextureBuffer bases;   // r32ui
 layout(binding = 2) uniform utextureBuffer scores;  // rgba32ui, two texels per unit row
 layout(std430, binding = 3) readonly buffer Candidates { uint count; uint pad0; uint pad1; uint pad2; uvec4 items[]; };
 layout(std430, binding = 4) readonly buffer State { REFINE_STATE };
-layout(std430, binding = 5) writeonly buffer Results { uvec2 results[]; };
+// The refined matches: template, coarse row and column (as the candidate), then the score in
+// the high 16 bits, the window row and column in bits 8-15 and 0-7.
+layout(std430, binding = 5) buffer Refined { uint refined_count; uint rpad0; uint rpad1; uint rpad2; uvec4 refined[]; };
 layout(binding = 6) uniform utextureBuffer shifts;  // r32ui, per template band
-layout(push_constant) uniform ChunkPushBlock { ChunkPush pc; };
+// The finer level's template headers (similarity_common.glsl): int 4 is the least score
+// that passes the threshold there (match::refinedPassScore).
+layout(binding = 7) uniform itextureBuffer fine_headers;
+layout(push_constant) uniform SelectPushBlock { SelectPush pc; };
 
 uint unitIndex(uint bit) {
   int word = int(bit >> 5);
@@ -75,5 +83,11 @@ void main() {
     uint s = j < 16 ? scoreAt(lo0, hi0, j) : scoreAt(lo1, hi1, j - 16);
     best_column = j >= o && j < o + 16 && s == best ? j - o : best_column;
   }
-  results[cand] = uvec2(best, best == 0u ? 0u : uint((best_row << 8) | best_column));
+  uint pass_score = uint(texelFetch(fine_headers, t * kHeaderInts + 4).x);
+  // Appended in a loop that runs only when a lane passes (llvmpipe would run an `if`'s atomic
+  // loop over the lanes for every invocation; see similarity_coarse.comp).
+  for (uint any = best >= pass_score && best > 0u ? 1u : 0u; any > 0u; --any) {
+    uint slot = atomicAdd(refined_count, 1u);
+    if (slot < pc.capacity) refined[slot] = uvec4(item.xyz, (best << 16u) | uint((best_row << 8) | best_column));
+  }
 }

@@ -112,10 +112,16 @@ struct CoarsePush {
   int cells_y;
   int boxes_at;       // the band boxes' first texel in depth_cells
 };
-// refine_mark, refine_select
+// refine_mark
 struct ChunkPush {
   int template_base;
   UnitGrid grid;
+};
+// refine_select
+struct SelectPush {
+  int template_base;
+  UnitGrid grid;
+  uint capacity;  // slots of the refined-match list
 };
 struct UnitsPush {
   uint bands;     // template bands of the chunk
@@ -168,7 +174,7 @@ static_assert(sizeof(FloatIntrinsics) == 16 && offsetof(FloatIntrinsics, fx) == 
 static_assert(sizeof(SizePush) == 8 && sizeof(SobelPush) == 16 && sizeof(PyrDownPush) == 16 &&
               sizeof(DepthNormalsPush) == 16 && sizeof(DownsampleLabelsPush) == 12 && sizeof(SpreadPush) == 12 &&
               sizeof(LinearizePush) == 32);
-static_assert(sizeof(UnitGrid) == 24 && sizeof(CoarsePush) == 24 && sizeof(ChunkPush) == 28 &&
+static_assert(sizeof(UnitGrid) == 24 && sizeof(CoarsePush) == 24 && sizeof(ChunkPush) == 28 && sizeof(SelectPush) == 32 &&
               sizeof(UnitsPush) == 32 && sizeof(ArgsPush) == 12 && sizeof(RefinePush) == 32);
 static_assert(sizeof(ScorePush) == 40 && sizeof(RasterPush) == 32);
 }  // namespace vkpose::gpu

@@ -1,6 +1,7 @@
 #pragma once
 // Conventions shared by the CPU reference matcher and the GPU matcher, so the two cannot
 // drift apart: position offsets, thresholds, refinement windows and memory layouts.
+#include <algorithm>
 #include <vector>
 
 #include "match/features.hpp"
@@ -26,6 +27,15 @@ inline int rawThreshold(int feature_count, float threshold_percent) {
 
 inline float similarityPercent(int raw_score, int feature_count) {
   return (raw_score * 100.f) / (4 * feature_count);
+}
+
+/// The least raw score whose similarityPercent reaches `threshold_percent` (4 n + 1 when
+/// none does): the finer level's pass test, in integers for the GPU, and exactly the host's.
+inline int refinedPassScore(int feature_count, float threshold_percent) {
+  int s = std::max(0, rawThreshold(feature_count, threshold_percent) - 4);
+  while (s <= 4 * feature_count && similarityPercent(s, feature_count) < threshold_percent) ++s;
+  while (s > 0 && similarityPercent(s - 1, feature_count) >= threshold_percent) --s;
+  return s;
 }
 
 /// Coarse-level positions of a template: the cell positions whose template centre lies in
@@ -83,5 +93,8 @@ inline int refineWindowStart(int coarse_cell, int T_coarse, int T_fine) {
 std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates, const std::vector<RefineResult>& refined,
                                  const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
                                  const MatchParams& params);
+
+/// Keeps one of each template's matches at one position (repeats are equal), in no order.
+void removeRepeatedMatches(std::vector<Match>& matches);
 
 }  // namespace vkpose::match

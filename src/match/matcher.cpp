@@ -133,6 +133,7 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
   std::size_t chunks = similarity_->chunkCount();
   std::size_t per_pass = p.per_pass;
   std::size_t most_candidates = 0;  // of one pass
+  std::size_t coarse_candidates = 0;
   for (std::size_t begin = 0, attempt = 0, pass = 0; begin < chunks; ++pass) {
     const std::size_t end = std::min(chunks, begin + per_pass);
     if (pass == 0) {
@@ -159,7 +160,8 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
     }
     ++timings_.attempts;
     if (similarity_->read(pass_candidates, pass_refined)) {
-      most_candidates = std::max(most_candidates, pass_candidates.size());
+      most_candidates = std::max(most_candidates, similarity_->coarseCount());
+      coarse_candidates += similarity_->coarseCount();
       candidates.insert(candidates.end(), pass_candidates.begin(), pass_candidates.end());
       refined.insert(refined.end(), pass_refined.begin(), pass_refined.end());
       begin = end;
@@ -179,6 +181,7 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
       candidates.clear();
       refined.clear();
       most_candidates = 0;
+      coarse_candidates = 0;
       begin = 0;
       attempt = 0;
       continue;
@@ -195,7 +198,7 @@ std::vector<Match> LinemodMatcher::collectFrame(bool wall_clock) {
   chunks_per_pass_ = most_candidates < similarity_->maxCandidates() / 2 ? std::min(chunks, 2 * per_pass) : per_pass;
   const auto t0 = std::chrono::steady_clock::now();
   timings_.chunks = chunks;
-  timings_.coarse_candidates = candidates.size();
+  timings_.coarse_candidates = coarse_candidates;
   auto matches = match::finishMatches(candidates, refined, templates_, feature_params_, params_);
   timings_.finish_ms = msSince(t0);
   return matches;

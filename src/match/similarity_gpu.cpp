@@ -48,7 +48,10 @@ match::CoarseRange appendTemplate(const LinemodTemplate& tmpl, const std::vector
     const auto& level = tmpl.levels[l];
     const auto& layout = layouts[l];
     const int n = static_cast<int>(level.features.size());
-    const int threshold = match::rawThreshold(n, params.threshold);
+    // The coarse level's threshold (similarity_coarse.comp) and, with refinement, the finer
+    // level's least passing score (refine_select.comp).
+    const int threshold = l == 0 && levels > 1 ? match::refinedPassScore(n, params.threshold)
+                                               : match::rawThreshold(n, params.threshold);
     const auto range = l + 1 == levels ? match::coarseRange(level, layout, threshold, params.outside_response)
                                        : match::CoarseRange{};
     const int32_t header[] = {static_cast<int32_t>(offsets[l].size()), n, range.c_lo, range.r_lo,
@@ -73,11 +76,12 @@ struct Similarity::Kernels {
         mark(c, ShaderId::refine_mark, 4, sizeof(ChunkPush)),
         units(c, ShaderId::refine_units, 7, sizeof(UnitsPush)),
         args(c, ShaderId::refine_args, 2, sizeof(ArgsPush)),
-        select(c, ShaderId::refine_select, 7, sizeof(ChunkPush), {},
+        select(c, ShaderId::refine_select, 8, sizeof(SelectPush), {},
                {{0, vk::Format::eR32Uint},
                 {1, vk::Format::eR32Uint},
                 {2, vk::Format::eR32G32B32A32Uint},
-                {6, vk::Format::eR32Uint}}) {
+                {6, vk::Format::eR32Uint},
+                {7, vk::Format::eR32Sint}}) {
     for (uint32_t span = 1; span <= kMaxSpan; ++span)
       refine.push_back(std::make_unique<Kernel>(c, ShaderId::similarity_refine, 6, sizeof(RefinePush),
                                                 std::vector<uint32_t>{span}, kMemoryAndOffsets));
@@ -193,10 +197,12 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
   const auto& cl = layouts_[coarse];
   const bool refine = coarse > 0;
   candidates_.reserve(ctx_, 16 + static_cast<std::size_t>(capacity_) * 16, MemoryKind::HostVisible);
-  results_.reserve(ctx_, static_cast<std::size_t>(capacity_) * 8, MemoryKind::HostVisible);
+  // The refined matches are a subset of the candidates: as many slots never overflow.
+  if (refine) refined_.reserve(ctx_, 16 + static_cast<std::size_t>(capacity_) * 16, MemoryKind::HostVisible);
   state_.reserve(ctx_, kStateBytes, MemoryKind::HostVisible);
   batch.fill(candidates_, 0u, 16);
   batch.fill(state_, 0u, kStateBytes);
+  if (refine) batch.fill(refined_, 0u, 16);
   UnitGrid grid{};  // all 0 without refinement
   if (refine) {
     grid = unitGrid(cl, layouts_[0]);
@@ -234,8 +240,9 @@ void Similarity::record(Batch& batch, const FrameFeatures& features, std::size_t
       batch.dispatchIndirect(*kernels_->refine[span - 1],
                              {features.memory(0), chunk.headers[0], chunk.offsets[0], runs_, state_, scores_},
                              RefinePush{fl.stride, unit_capacity_, grid}, state_, kRunArgs + 16 * (span - 1));
-    batch.dispatchIndirect(kernels_->select, {blocks_, bases_, scores_, candidates_, state_, results_, shifts_},
-                           chunk_push, state_, kCandidateArgs);
+    batch.dispatchIndirect(kernels_->select,
+                           {blocks_, bases_, scores_, candidates_, state_, refined_, shifts_, chunk.headers[0]},
+                           SelectPush{chunk.first_template, grid, capacity_}, state_, kCandidateArgs);
   }
 }
 
@@ -270,18 +277,26 @@ bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vect
     }
   }
   if (!complete) return false;
-  candidates.resize(count);
-  for (uint32_t i = 0; i < count; ++i) {
-    const uint32_t* item = words + 4 + 4 * i;
-    candidates[i] = {static_cast<int>(item[0]), static_cast<int32_t>(item[1]), static_cast<int32_t>(item[2]),
-                     static_cast<int>(item[3])};
+  coarse_count_ = count;
+  if (layouts_.size() == 1) {
+    candidates.resize(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint32_t* item = words + 4 + 4 * i;
+      candidates[i] = {static_cast<int>(item[0]), static_cast<int32_t>(item[1]), static_cast<int32_t>(item[2]),
+                       static_cast<int>(item[3])};
+    }
+    return true;
   }
-  if (layouts_.size() > 1) {
-    const auto* res = static_cast<const uint32_t*>(results_.mapped());
-    refined.resize(count);
-    for (uint32_t i = 0; i < count; ++i)
-      refined[i] = {static_cast<int>(res[2 * i]), static_cast<int>(res[2 * i + 1] >> 8),
-                    static_cast<int>(res[2 * i + 1] & 0xFF)};
+  // With refinement, only the candidates whose refinement passed (refine_select.comp).
+  const auto* listed = static_cast<const uint32_t*>(refined_.mapped());
+  const uint32_t passed = std::min(listed[0], count);
+  candidates.resize(passed);
+  refined.resize(passed);
+  for (uint32_t i = 0; i < passed; ++i) {
+    const uint32_t* item = listed + 4 + 4 * i;
+    candidates[i] = {static_cast<int>(item[0]), static_cast<int32_t>(item[1]), static_cast<int32_t>(item[2]), 0};
+    refined[i] = {static_cast<int>(item[3] >> 16), static_cast<int>((item[3] >> 8) & 0xFF),
+                  static_cast<int>(item[3] & 0xFF)};
   }
   // The device appends in no fixed order; the host sorts (finishMatches) for determinism.
   return true;

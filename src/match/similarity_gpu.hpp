@@ -37,11 +37,14 @@ class Similarity {
   /// Records coarse scoring and refinement of the template chunks [begin, end).
   void record(Batch& batch, const FrameFeatures& features, std::size_t begin, std::size_t end);
 
-  /// After the batch's submit: the candidates and refinements. Returns false when the
-  /// candidate list or the unit list overflowed (they grow; run the pass again). When the
-  /// candidate list is already as large as one binding allows, full() turns true: the pass
-  /// must cover fewer chunks.
+  /// After the batch's submit: the candidates, or with refinement the candidates whose
+  /// refinement passed the threshold with their refinements (their coarse score left 0).
+  /// Returns false when the candidate list or the unit list overflowed (they grow; run the
+  /// pass again). When the candidate list is already as large as one binding allows, full()
+  /// turns true: the pass must cover fewer chunks.
   bool read(std::vector<match::CoarseCandidate>& candidates, std::vector<match::RefineResult>& refined);
+  /// The coarse candidates of the last read() pass, all of them (refined or not).
+  std::size_t coarseCount() const { return coarse_count_; }
   bool full() const { return full_; }
   /// After a read() that returned false: a chunk's refinement units outgrew one binding of
   /// unit scores. splitChunks() halves the chunks (false when they are single templates
@@ -76,7 +79,8 @@ class Similarity {
   std::size_t template_bands_ = 0;     // template bands of the largest chunk
   std::size_t block_words_ = 0;        // and its block mark words
   std::size_t column_words_ = 0;       // and its column mark words
-  Buffer candidates_, results_, depth_;
+  std::size_t coarse_count_ = 0;
+  Buffer candidates_, refined_, depth_;
   Buffer columns_, occupied_, blocks_, bases_, shifts_, runs_, scores_, state_;
 };
 
