@@ -53,9 +53,16 @@ class ClusterScoreKernels;
 
 /// Stage 4 on the GPU: one submit scores every member of every hypothesis
 /// (shaders/cluster_score.comp), then combineMemberScores.
+///
+/// The banks' depth and normal crops go up once and stay on the device while the same banks
+/// come back (the same TemplateBank objects, unchanged: a Detector's): a frame of many
+/// objects scores some 40,000 templates, 200 MB of crops, which cost more to gather and
+/// upload every frame than to score. Banks whose crops exceed `resident_crop_bytes` (or one
+/// texel-buffer binding) have the crops of each frame's members uploaded with it instead.
 class ClusterScorer {
  public:
-  explicit ClusterScorer(const GpuContext& ctx);
+  static constexpr std::size_t kResidentCropBytes = std::size_t(1) << 30;
+  explicit ClusterScorer(const GpuContext& ctx, std::size_t resident_crop_bytes = kResidentCropBytes);
   ~ClusterScorer();
   ClusterScorer(const ClusterScorer&) = delete;
   ClusterScorer& operator=(const ClusterScorer&) = delete;
