@@ -1,12 +1,16 @@
 // Stages 3 and 5: template clustering and non-maximum suppression.
 #include <algorithm>
+#include <bit>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <tuple>
 
 #include <Eigen/Geometry>
 
 #include "hypotheses/hypotheses.hpp"
 #include "match/matcher.hpp"
+#include "util/radix_sort.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/error.hpp"
@@ -39,6 +43,67 @@ std::vector<LinemodTemplate> concatenateTemplates(const std::vector<TemplateBank
   return all;
 }
 
+namespace {
+
+using Key = std::tuple<int, int, int, long>;  // bank, cell row, cell column, distance (0.1 mm)
+struct Entry {
+  Key key;
+  ClusterMember member;
+  std::size_t order;  // the match's index: among equal similarities the first wins
+  int distance_slot;  // the key's distance as an index into clusterTemplates' distances
+};
+
+/// Sorts the entries by key, then template, then order: each template's matches in a key
+/// are then neighbours, the first of them first. Packed into 64-bit keys (the distance as its
+/// rank among the few distinct ones) and radix-sorted where they fit, which is several times
+/// faster than sorting the tuples (LM-O's frame: 928,000 entries); else sorted as tuples.
+void sortForGrouping(std::vector<Entry>& entries, const std::vector<long>& distances) {
+  if (entries.empty()) return;
+  std::vector<int> rank(distances.size());
+  {
+    std::vector<long> sorted = distances;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t k = 0; k < distances.size(); ++k)
+      rank[k] = static_cast<int>(std::lower_bound(sorted.begin(), sorted.end(), distances[k]) - sorted.begin());
+  }
+  int min_r = INT32_MAX, max_r = INT32_MIN, min_c = INT32_MAX, max_c = INT32_MIN, max_b = 0, max_t = 0;
+  for (const Entry& e : entries) {
+    min_r = std::min(min_r, std::get<1>(e.key)), max_r = std::max(max_r, std::get<1>(e.key));
+    min_c = std::min(min_c, std::get<2>(e.key)), max_c = std::max(max_c, std::get<2>(e.key));
+    max_b = std::max(max_b, std::get<0>(e.key)), max_t = std::max(max_t, e.member.template_index);
+  }
+  auto bits = [](int64_t v) { return static_cast<int>(std::bit_width(static_cast<uint64_t>(v))); };
+  const int bb = bits(max_b), br = bits(int64_t(max_r) - min_r), bc = bits(int64_t(max_c) - min_c);
+  const int bd = bits(static_cast<int64_t>(distances.size()) - 1), bt = bits(max_t);
+  const int bo = bits(static_cast<int64_t>(entries.size()) - 1);
+  if (bb + br + bc + bd + bt + bo > 64) {
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      if (a.key != b.key) return a.key < b.key;
+      if (a.member.template_index != b.member.template_index) return a.member.template_index < b.member.template_index;
+      return a.order < b.order;
+    });
+    return;
+  }
+  std::vector<uint64_t> keys(entries.size()), scratch;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const Entry& e = entries[i];
+    uint64_t k = static_cast<uint64_t>(std::get<0>(e.key));
+    k = (k << br) | static_cast<uint64_t>(int64_t(std::get<1>(e.key)) - min_r);
+    k = (k << bc) | static_cast<uint64_t>(int64_t(std::get<2>(e.key)) - min_c);
+    k = (k << bd) | static_cast<uint64_t>(rank[static_cast<std::size_t>(e.distance_slot)]);
+    k = (k << bt) | static_cast<uint64_t>(e.member.template_index);
+    keys[i] = bo > 0 ? (k << bo) | i : k;  // i: the entries are in match order
+  }
+  util::radixSort(keys, scratch);
+  std::vector<Entry> sorted;
+  sorted.reserve(entries.size());
+  const uint64_t index_mask = bo > 0 ? (uint64_t(1) << bo) - 1 : 0;
+  for (const uint64_t k : keys) sorted.push_back(entries[static_cast<std::size_t>(k & index_mask)]);
+  entries.swap(sorted);
+}
+
+}  // namespace
+
 std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, const std::vector<TemplateBank>& banks,
                                          const ClusterParams& params) {
   if (params.position_step_px < 1) throw InputError("cluster position step s_im must be at least 1 pixel");
@@ -49,14 +114,11 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
   // Key: bank, cell row, cell column, training distance (whole 0.1 mm, so equal radii group
   // exactly). Per key, the best match of each template (the first of equals). Sorting one flat
   // array instead of filling a map of maps: LM-O frames bring 300,000 matches (364 -> 131 ms).
-  using Key = std::tuple<int, int, int, long>;
-  struct Entry {
-    Key key;
-    ClusterMember member;
-    std::size_t order;  // the match's index: among equal similarities the first wins
-  };
   std::vector<Entry> entries;
   entries.reserve(matches.size());
+  // Each template's training distance as one of the few distinct ones (the packed sort's key).
+  std::vector<std::vector<int>> distance_slot(banks.size());
+  std::vector<long> distances;
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const Match& m = matches[i];
     const int b = index.bankOf(m.template_id);
@@ -64,25 +126,32 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
     const BankTemplate& t = banks[static_cast<std::size_t>(b)].templates[static_cast<std::size_t>(local)];
     ClusterMember member{local, m.x, m.y, m.similarity, static_cast<float>(m.x) + t.anchor_x,
                          static_cast<float>(m.y) + t.anchor_y};
+    const long distance = std::lround(t.distance * 1e4f);
+    auto& slots = distance_slot[static_cast<std::size_t>(b)];
+    if (slots.empty()) slots.assign(banks[static_cast<std::size_t>(b)].templates.size(), -1);
+    int& slot = slots[static_cast<std::size_t>(local)];
+    if (slot < 0) {
+      slot = static_cast<int>(std::find(distances.begin(), distances.end(), distance) - distances.begin());
+      if (slot == static_cast<int>(distances.size())) distances.push_back(distance);
+    }
     const Key key{b, static_cast<int>(std::floor(member.centre_y / step)),
-                  static_cast<int>(std::floor(member.centre_x / step)), std::lround(t.distance * 1e4f)};
-    entries.push_back({key, member, i});
+                  static_cast<int>(std::floor(member.centre_x / step)), distance};
+    entries.push_back({key, member, i, slot});
   }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    if (a.key != b.key) return a.key < b.key;
-    if (a.member.template_index != b.member.template_index) return a.member.template_index < b.member.template_index;
-    if (a.member.similarity != b.member.similarity) return a.member.similarity > b.member.similarity;
-    return a.order < b.order;
-  });
+  sortForGrouping(entries, distances);
 
   std::vector<Hypothesis> hypotheses;
   std::vector<ClusterMember> members;  // one key's, by template index
   for (std::size_t first = 0; first < entries.size();) {
     std::size_t end = first;
     members.clear();
-    for (; end < entries.size() && entries[end].key == entries[first].key; ++end)
-      if (members.empty() || members.back().template_index != entries[end].member.template_index)
-        members.push_back(entries[end].member);  // the template's best
+    for (; end < entries.size() && entries[end].key == entries[first].key; ++end) {
+      const ClusterMember& m = entries[end].member;
+      if (members.empty() || members.back().template_index != m.template_index)
+        members.push_back(m);
+      else if (m.similarity > members.back().similarity)  // the template's best, first of equals
+        members.back() = m;
+    }
     const Key key = entries[first].key;
     first = end;
     if (static_cast<int>(members.size()) < params.min_templates) continue;
