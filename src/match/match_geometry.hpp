@@ -94,7 +94,8 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
                                  const std::vector<LinemodTemplate>& templates, const FeatureParams& feature_params,
                                  const MatchParams& params);
 
-/// Keeps one of each template's matches at one position (repeats are equal), in no order.
-void removeRepeatedMatches(std::vector<Match>& matches);
+/// Keeps one of each template's matches at one position (repeats are equal) and sorts them
+/// best first (sortMatches' order).
+void sortDistinctMatches(std::vector<Match>& matches);
 
 }  // namespace vkpose::match

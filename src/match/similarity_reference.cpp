@@ -34,6 +34,7 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
   std::vector<int> feature_counts(templates.size());
   for (std::size_t t = 0; t < templates.size(); ++t) feature_counts[t] = featureCount(templates[t], 0);
   std::vector<Match> out;
+  out.reserve(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const auto& cand = candidates[i];
     const int features = feature_counts[static_cast<std::size_t>(cand.template_id)];
@@ -57,17 +58,18 @@ std::vector<Match> finishMatches(const std::vector<CoarseCandidate>& candidates,
     }
     out.push_back(m);
   }
-  removeRepeatedMatches(out);
-  sortMatches(out);
+  sortDistinctMatches(out);
   return out;
 }
 
-void removeRepeatedMatches(std::vector<Match>& matches) {
+void sortDistinctMatches(std::vector<Match>& matches) {
   if (matches.empty()) return;
   // Candidates whose refinements land on the same position of a template give the same match
   // (a frame of many objects: 4 million matches, a fifth of them distinct). Template and
   // position packed into a 64-bit key with the match's index below, radix-sorted: repeats
-  // become neighbours for a fraction of sorting the matches themselves.
+  // become neighbours, and the distinct matches come out by template, y and x, for a
+  // fraction of sorting the matches themselves. A stable radix sort by similarity then gives
+  // sortMatches' order.
   int min_x = matches[0].x, max_x = min_x, min_y = matches[0].y, max_y = min_y, max_t = 0;
   for (const Match& m : matches) {
     min_x = std::min(min_x, m.x), max_x = std::max(max_x, m.x);
@@ -99,7 +101,17 @@ void removeRepeatedMatches(std::vector<Match>& matches) {
   for (std::size_t k = 0; k < keys.size(); ++k)
     if (k == 0 || (keys[k] >> bi) != (keys[k - 1] >> bi))
       distinct.push_back(matches[static_cast<std::size_t>(keys[k] & ((std::uint64_t(1) << bi) - 1))]);
-  matches.swap(distinct);
+  // Best first: the similarity's bits made to sort as the floats do, inverted, above the
+  // index (which keeps equal similarities in template, y, x order).
+  keys.resize(distinct.size());
+  for (std::size_t i = 0; i < distinct.size(); ++i) {
+    const auto raw = std::bit_cast<std::uint32_t>(distinct[i].similarity);
+    const std::uint32_t ordered = (raw & 0x80000000u) ? ~raw : raw | 0x80000000u;
+    keys[i] = (std::uint64_t(~ordered) << 32) | i;
+  }
+  util::radixSort(keys, scratch);
+  matches.resize(distinct.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) matches[i] = distinct[static_cast<std::size_t>(keys[i] & 0xFFFFFFFFu)];
 }
 
 }  // namespace match

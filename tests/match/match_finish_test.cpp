@@ -34,10 +34,10 @@ std::vector<Match> plainWay(std::vector<Match> matches) {
   return matches;
 }
 
-// Repeats (one template's candidates refined to the same position) come out once, as sorting
-// and std::unique would leave them, with negative positions, and with coordinates too far
-// apart for the packed keys (the plain way then).
-TEST(MatchFinish, RepeatedMatchesAreRemovedAsSortingWould) {
+// Repeats (one template's candidates refined to the same position) come out once, best first,
+// as sorting and std::unique would leave them: with many equal similarities, negative
+// positions, and coordinates too far apart for the packed keys (the plain way then).
+TEST(MatchFinish, DistinctMatchesComeOutAsSortingAndUniqueWouldLeaveThem) {
   std::mt19937 rng(5);
   for (const int spread : {1, 40, 700, INT_MAX / 4}) {
     std::vector<Match> matches;
@@ -54,16 +54,15 @@ TEST(MatchFinish, RepeatedMatchesAreRemovedAsSortingWould) {
     }
     std::shuffle(matches.begin(), matches.end(), rng);
     const std::vector<Match> expected = plainWay(matches);
-    match::removeRepeatedMatches(matches);
+    match::sortDistinctMatches(matches);
     EXPECT_EQ(matches.size(), expected.size()) << "spread " << spread;
-    sortMatches(matches);
     EXPECT_EQ(matches, expected) << "spread " << spread;
   }
   std::vector<Match> none;
-  match::removeRepeatedMatches(none);
+  match::sortDistinctMatches(none);
   EXPECT_TRUE(none.empty());
   std::vector<Match> one(1);
-  match::removeRepeatedMatches(one);
+  match::sortDistinctMatches(one);
   EXPECT_EQ(one.size(), 1u);
 }
 
