@@ -71,25 +71,32 @@ bool NearestNeighbours::Grid::search(const PointCloud& sorted, const Eigen::Vect
   return false;
 }
 
-void NearestNeighbours::Grid::scanBall(const PointCloud& sorted, const Eigen::Vector3f& q, int& best,
-                                       float& best_sqr) const {
-  const float radius = std::sqrt(best_sqr);
+template <class Visit>
+void NearestNeighbours::Grid::forCellsOfBall(const Eigen::Vector3f& q, float radius, Visit&& visit) const {
   const Eigen::Vector3f lo = ((q.array() - radius - origin.array()) * inv_cell).floor().matrix();
   const Eigen::Vector3f hi = ((q.array() + radius - origin.array()) * inv_cell).floor().matrix();
-  // Clamped to the grid before the casts (q may be anywhere).
-  auto first = [](float v, int n) { return static_cast<int>(std::clamp(v, 0.f, float(n))); };
-  auto last = [](float v, int n) { return static_cast<int>(std::clamp(v, -1.f, float(n - 1))); };
-  const int x0 = first(lo.x(), nx), x1 = last(hi.x(), nx), y0 = first(lo.y(), ny), y1 = last(hi.y(), ny);
-  const int z0 = first(lo.z(), nz), z1 = last(hi.z(), nz);
-  if (x0 > x1) return;
+  // The overlapped cells, clamped to the grid before the casts (q may be anywhere).
+  auto range = [](float a, float b, int n, int& i0, int& i1) {
+    i0 = static_cast<int>(std::clamp(a, 0.f, float(n)));
+    i1 = static_cast<int>(std::clamp(b, -1.f, float(n - 1)));
+    return i0 <= i1;
+  };
+  int x0, x1, y0, y1, z0, z1;
+  if (!range(lo.x(), hi.x(), nx, x0, x1) || !range(lo.y(), hi.y(), ny, y0, y1) || !range(lo.z(), hi.z(), nz, z0, z1))
+    return;
   for (int z = z0; z <= z1; ++z)
     for (int y = y0; y <= y1; ++y) {
       const std::size_t row = (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx);
-      for (std::uint32_t i = start[row + std::size_t(x0)], end = start[row + std::size_t(x1) + 1]; i < end; ++i) {
-        const float d = (sorted[i] - q).squaredNorm();
-        if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
-      }
+      for (std::uint32_t i = start[row + std::size_t(x0)], end = start[row + std::size_t(x1) + 1]; i < end; ++i) visit(i);
     }
+}
+
+void NearestNeighbours::Grid::scanBall(const PointCloud& sorted, const Eigen::Vector3f& q, int& best,
+                                       float& best_sqr) const {
+  forCellsOfBall(q, std::sqrt(best_sqr), [&](std::uint32_t i) {
+    const float d = (sorted[i] - q).squaredNorm();
+    if (d < best_sqr) best_sqr = d, best = static_cast<int>(i);
+  });
 }
 
 NearestNeighbours::NearestNeighbours(const PointCloud& points, float cell, std::size_t max_cells) {
@@ -178,25 +185,10 @@ int NearestNeighbours::nearest(const Eigen::Vector3f& q, int hint, float& dist_s
 
 void NearestNeighbours::within(const Eigen::Vector3f& q, float radius, std::vector<int>& out) const {
   if (points_.empty() || !q.allFinite() || !(radius >= 0.f)) return;
-  const Grid& g = fine_;
-  const Eigen::Vector3f lo = ((q.array() - radius - g.origin.array()) * g.inv_cell).floor().matrix();
-  const Eigen::Vector3f hi = ((q.array() + radius - g.origin.array()) * g.inv_cell).floor().matrix();
-  // The overlapped cells, clamped to the grid before the casts (q may be anywhere).
-  auto range = [](float a, float b, int n, int& i0, int& i1) {
-    i0 = static_cast<int>(std::clamp(a, 0.f, float(n)));
-    i1 = static_cast<int>(std::clamp(b, -1.f, float(n - 1)));
-    return i0 <= i1;
-  };
-  int x0, x1, y0, y1, z0, z1;
-  if (!range(lo.x(), hi.x(), g.nx, x0, x1) || !range(lo.y(), hi.y(), g.ny, y0, y1) || !range(lo.z(), hi.z(), g.nz, z0, z1))
-    return;
   const float r2 = radius * radius;
-  for (int z = z0; z <= z1; ++z)
-    for (int y = y0; y <= y1; ++y) {
-      const std::size_t row = (std::size_t(z) * std::size_t(g.ny) + std::size_t(y)) * std::size_t(g.nx);
-      for (std::uint32_t i = g.start[row + std::size_t(x0)], end = g.start[row + std::size_t(x1) + 1]; i < end; ++i)
-        if ((points_[i] - q).squaredNorm() <= r2) out.push_back(original_[i]);
-    }
+  fine_.forCellsOfBall(q, radius, [&](std::uint32_t i) {
+    if ((points_[i] - q).squaredNorm() <= r2) out.push_back(original_[i]);
+  });
 }
 
 }  // namespace vkpose

@@ -57,6 +57,10 @@ class NearestNeighbours {
     /// Scans the cells that the ball of radius sqrt(best_sqr) around q overlaps; updates best /
     /// best_sqr (indices into `order`, best may be -1) with any point strictly nearer.
     void scanBall(const PointCloud& sorted, const Eigen::Vector3f& q, int& best, float& best_sqr) const;
+    /// Calls visit(i) for every point (its index into the grid's order) of the cells that the
+    /// ball of `radius` around q overlaps, row of cells by row.
+    template <class Visit>
+    void forCellsOfBall(const Eigen::Vector3f& q, float radius, Visit&& visit) const;
     std::vector<int> order;             // sorted[i] = points[order[i]]
     std::vector<std::uint32_t> start;   // a cell's points are sorted[start[c], start[c + 1])
     Eigen::Vector3f origin = Eigen::Vector3f::Zero();
