@@ -114,29 +114,34 @@ std::vector<Hypothesis> clusterTemplates(const std::vector<Match>& matches, cons
   // Key: bank, cell row, cell column, training distance (whole 0.1 mm, so equal radii group
   // exactly). Per key, the best match of each template (the first of equals). Sorting one flat
   // array instead of filling a map of maps: LM-O frames bring 300,000 matches (364 -> 131 ms).
+  // What a match needs of its template, by global template id, in one small table: reaching
+  // each BankTemplate (a few hundred bytes apart) for every match was most of the stage.
+  struct Placing {
+    float anchor_x, anchor_y;
+    int bank, slot;  // slot: the training distance as an index into `distances`
+  };
+  std::vector<Placing> placing;
+  placing.reserve(static_cast<std::size_t>(index.first.back()));
+  std::vector<long> distances;  // the distinct training distances (0.1 mm)
+  for (std::size_t b = 0; b < banks.size(); ++b)
+    for (const BankTemplate& t : banks[b].templates) {
+      const long distance = std::lround(t.distance * 1e4f);
+      auto slot = std::find(distances.begin(), distances.end(), distance) - distances.begin();
+      if (slot == static_cast<std::ptrdiff_t>(distances.size())) distances.push_back(distance);
+      placing.push_back({t.anchor_x, t.anchor_y, static_cast<int>(b), static_cast<int>(slot)});
+    }
   std::vector<Entry> entries;
   entries.reserve(matches.size());
-  // Each template's training distance as one of the few distinct ones (the packed sort's key).
-  std::vector<std::vector<int>> distance_slot(banks.size());
-  std::vector<long> distances;
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const Match& m = matches[i];
-    const int b = index.bankOf(m.template_id);
-    const int local = m.template_id - index.first[static_cast<std::size_t>(b)];
-    const BankTemplate& t = banks[static_cast<std::size_t>(b)].templates[static_cast<std::size_t>(local)];
-    ClusterMember member{local, m.x, m.y, m.similarity, static_cast<float>(m.x) + t.anchor_x,
-                         static_cast<float>(m.y) + t.anchor_y};
-    const long distance = std::lround(t.distance * 1e4f);
-    auto& slots = distance_slot[static_cast<std::size_t>(b)];
-    if (slots.empty()) slots.assign(banks[static_cast<std::size_t>(b)].templates.size(), -1);
-    int& slot = slots[static_cast<std::size_t>(local)];
-    if (slot < 0) {
-      slot = static_cast<int>(std::find(distances.begin(), distances.end(), distance) - distances.begin());
-      if (slot == static_cast<int>(distances.size())) distances.push_back(distance);
-    }
-    const Key key{b, static_cast<int>(std::floor(member.centre_y / step)),
-                  static_cast<int>(std::floor(member.centre_x / step)), distance};
-    entries.push_back({key, member, i, slot});
+    if (m.template_id < 0 || m.template_id >= index.first.back()) index.bankOf(m.template_id);  // throws
+    const Placing& p = placing[static_cast<std::size_t>(m.template_id)];
+    const int local = m.template_id - index.first[static_cast<std::size_t>(p.bank)];
+    ClusterMember member{local, m.x, m.y, m.similarity, static_cast<float>(m.x) + p.anchor_x,
+                         static_cast<float>(m.y) + p.anchor_y};
+    const Key key{p.bank, static_cast<int>(std::floor(member.centre_y / step)),
+                  static_cast<int>(std::floor(member.centre_x / step)), distances[static_cast<std::size_t>(p.slot)]};
+    entries.push_back({key, member, i, p.slot});
   }
   sortForGrouping(entries, distances);
 
