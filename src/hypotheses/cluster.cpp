@@ -75,8 +75,7 @@ void sortForGrouping(std::vector<Entry>& entries, const std::vector<long>& dista
   auto bits = [](int64_t v) { return static_cast<int>(std::bit_width(static_cast<uint64_t>(v))); };
   const int bb = bits(max_b), br = bits(int64_t(max_r) - min_r), bc = bits(int64_t(max_c) - min_c);
   const int bd = bits(static_cast<int64_t>(distances.size()) - 1), bt = bits(max_t);
-  const int bo = bits(static_cast<int64_t>(entries.size()) - 1);
-  if (bb + br + bc + bd + bt + bo > 64) {
+  if (!util::fitsWithIndex(bb + br + bc + bd + bt, entries.size())) {
     std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
       if (a.key != b.key) return a.key < b.key;
       if (a.member.template_index != b.member.template_index) return a.member.template_index < b.member.template_index;
@@ -84,21 +83,18 @@ void sortForGrouping(std::vector<Entry>& entries, const std::vector<long>& dista
     });
     return;
   }
-  std::vector<uint64_t> keys(entries.size()), scratch;
+  std::vector<uint64_t> keys(entries.size());
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const Entry& e = entries[i];
     uint64_t k = static_cast<uint64_t>(std::get<0>(e.key));
     k = (k << br) | static_cast<uint64_t>(int64_t(std::get<1>(e.key)) - min_r);
     k = (k << bc) | static_cast<uint64_t>(int64_t(std::get<2>(e.key)) - min_c);
     k = (k << bd) | static_cast<uint64_t>(rank[static_cast<std::size_t>(e.distance_slot)]);
-    k = (k << bt) | static_cast<uint64_t>(e.member.template_index);
-    keys[i] = bo > 0 ? (k << bo) | i : k;  // i: the entries are in match order
+    keys[i] = (k << bt) | static_cast<uint64_t>(e.member.template_index);
   }
-  util::radixSort(keys, scratch);
   std::vector<Entry> sorted;
   sorted.reserve(entries.size());
-  const uint64_t index_mask = bo > 0 ? (uint64_t(1) << bo) - 1 : 0;
-  for (const uint64_t k : keys) sorted.push_back(entries[static_cast<std::size_t>(k & index_mask)]);
+  for (const uint32_t i : util::stableOrder(keys)) sorted.push_back(entries[i]);  // entries are in match order
   entries.swap(sorted);
 }
 

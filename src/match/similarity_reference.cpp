@@ -78,8 +78,8 @@ void sortDistinctMatches(std::vector<Match>& matches) {
   }
   auto bits = [](std::uint64_t v) { return static_cast<int>(std::bit_width(v)); };
   const int bx = bits(std::uint64_t(max_x - min_x)), by = bits(std::uint64_t(max_y - min_y));
-  const int bt = bits(std::uint64_t(max_t)), bi = bits(matches.size() - 1);
-  if (bx + by + bt + bi > 64) {  // never at camera sizes; the plain way
+  const int bt = bits(std::uint64_t(max_t));
+  if (!util::fitsWithIndex(bx + by + bt, matches.size())) {  // never at camera sizes; the plain way
     sortMatches(matches);
     matches.erase(std::unique(matches.begin(), matches.end(),
                               [](const Match& a, const Match& b) {
@@ -88,30 +88,28 @@ void sortDistinctMatches(std::vector<Match>& matches) {
                   matches.end());
     return;
   }
-  std::vector<std::uint64_t> keys(matches.size()), scratch;
+  std::vector<std::uint64_t> places(matches.size());
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const Match& m = matches[i];
-    const std::uint64_t place = (std::uint64_t(m.template_id) << (by + bx)) | (std::uint64_t(m.y - min_y) << bx) |
-                                std::uint64_t(m.x - min_x);
-    keys[i] = bi > 0 ? (place << bi) | i : place;
+    places[i] = (std::uint64_t(m.template_id) << (by + bx)) | (std::uint64_t(m.y - min_y) << bx) |
+                std::uint64_t(m.x - min_x);
   }
-  util::radixSort(keys, scratch);
   std::vector<Match> distinct;
   distinct.reserve(matches.size() / 4);
-  for (std::size_t k = 0; k < keys.size(); ++k)
-    if (k == 0 || (keys[k] >> bi) != (keys[k - 1] >> bi))
-      distinct.push_back(matches[static_cast<std::size_t>(keys[k] & ((std::uint64_t(1) << bi) - 1))]);
-  // Best first: the similarity's bits made to sort as the floats do, inverted, above the
-  // index (which keeps equal similarities in template, y, x order).
-  keys.resize(distinct.size());
+  std::uint64_t last = 0;
+  for (const std::uint32_t i : util::stableOrder(places)) {
+    if (distinct.empty() || places[i] != last) distinct.push_back(matches[i]);
+    last = places[i];
+  }
+  // Best first: the similarity's bits made to sort as the floats do, inverted (equal
+  // similarities stay in template, y, x order).
+  std::vector<std::uint64_t> similarity(distinct.size());
   for (std::size_t i = 0; i < distinct.size(); ++i) {
     const auto raw = std::bit_cast<std::uint32_t>(distinct[i].similarity);
-    const std::uint32_t ordered = (raw & 0x80000000u) ? ~raw : raw | 0x80000000u;
-    keys[i] = (std::uint64_t(~ordered) << 32) | i;
+    similarity[i] = ~((raw & 0x80000000u) ? ~raw : raw | 0x80000000u) & 0xFFFFFFFFu;
   }
-  util::radixSort(keys, scratch);
-  matches.resize(distinct.size());
-  for (std::size_t i = 0; i < keys.size(); ++i) matches[i] = distinct[static_cast<std::size_t>(keys[i] & 0xFFFFFFFFu)];
+  matches.clear();
+  for (const std::uint32_t i : util::stableOrder(similarity)) matches.push_back(distinct[i]);
 }
 
 }  // namespace match

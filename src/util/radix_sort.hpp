@@ -2,6 +2,7 @@
 // LSD radix sort of 64-bit keys: for the millions of keys of a frame's matches, several times
 // faster than std::sort (a pass per 11 bits of key, passes over bits all keys share skipped).
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -30,6 +31,24 @@ inline void radixSort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_
     for (const std::uint64_t k : keys) scratch[count[(k >> shift) & (kBuckets - 1)]++] = k;
     keys.swap(scratch);
   }
+}
+
+/// The order (indices) that sorts `keys` ascending, equal keys in index order. The index rides
+/// below the key, so the keys' bits and the largest index's must fit 64 (fitsWithIndex()).
+inline std::vector<std::uint32_t> stableOrder(const std::vector<std::uint64_t>& keys) {
+  const int index_bits = static_cast<int>(std::bit_width(keys.empty() ? 0u : keys.size() - 1));
+  std::vector<std::uint64_t> packed(keys.size()), scratch;
+  for (std::size_t i = 0; i < keys.size(); ++i) packed[i] = index_bits > 0 ? (keys[i] << index_bits) | i : keys[i];
+  radixSort(packed, scratch);
+  const std::uint64_t mask = index_bits > 0 ? (std::uint64_t(1) << index_bits) - 1 : 0;
+  std::vector<std::uint32_t> order(keys.size());
+  for (std::size_t k = 0; k < packed.size(); ++k) order[k] = static_cast<std::uint32_t>(packed[k] & mask);
+  return order;
+}
+
+/// Whether keys of `key_bits` bits leave room for the index of each of `count` keys.
+inline bool fitsWithIndex(int key_bits, std::size_t count) {
+  return count <= (std::size_t(1) << 32) && key_bits + static_cast<int>(std::bit_width(count == 0 ? 0u : count - 1)) <= 64;
 }
 
 }  // namespace vkpose::util
