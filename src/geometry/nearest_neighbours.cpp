@@ -125,17 +125,24 @@ NearestNeighbours::NearestNeighbours(const PointCloud& points, float cell, std::
   }
 }
 
-int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const {
+int NearestNeighbours::search(const Eigen::Vector3f& q, float bound_sqr, float& dist_sqr) const {
   dist_sqr = std::numeric_limits<float>::infinity();
   if (points_.empty() || !q.allFinite()) return -1;
   int best = -1;
   float best_sqr = std::numeric_limits<float>::infinity();
-  if (!fine_.search(points_, q, best, best_sqr)) {
+  // A grid that failed to prove its best still proves that no unseen point lies within its
+  // reach: where the bound lies within that, the best seen is the answer (or there is none).
+  auto settled = [&](const Grid& g) {
+    const float reach = static_cast<float>(kMaxRing) * g.cell;
+    return bound_sqr <= reach * reach;
+  };
+  if (!fine_.search(points_, q, best, best_sqr) && !settled(fine_)) {
     // The fine grid's best is a candidate for the coarse one, as an index into its order.
     int coarse_best = -1;
     if (best >= 0) coarse_best = coarse_rank_[static_cast<std::size_t>(best)];
-    if (coarse_.search(coarse_sorted_, q, coarse_best, best_sqr)) {
-      best = coarse_.order[static_cast<std::size_t>(coarse_best)];
+    const bool proved = coarse_.search(coarse_sorted_, q, coarse_best, best_sqr);
+    if (proved || settled(coarse_)) {
+      best = coarse_best < 0 ? -1 : coarse_.order[static_cast<std::size_t>(coarse_best)];
     } else {
       ++full_scans_;
       best = -1;
@@ -146,8 +153,21 @@ int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const 
       }
     }
   }
+  if (best < 0 || best_sqr > bound_sqr) return -1;
   dist_sqr = best_sqr;
-  return original_[static_cast<std::size_t>(best)];
+  return best;
+}
+
+int NearestNeighbours::nearest(const Eigen::Vector3f& q, float& dist_sqr) const {
+  const int best = search(q, std::numeric_limits<float>::infinity(), dist_sqr);
+  return best < 0 ? -1 : original_[static_cast<std::size_t>(best)];
+}
+
+int NearestNeighbours::nearestWithin(const Eigen::Vector3f& q, float max_dist, float& dist_sqr) const {
+  dist_sqr = std::numeric_limits<float>::infinity();
+  if (!(max_dist >= 0.f)) return -1;
+  const int best = search(q, max_dist * max_dist, dist_sqr);
+  return best < 0 ? -1 : original_[static_cast<std::size_t>(best)];
 }
 
 int NearestNeighbours::nearest(const Eigen::Vector3f& q, int hint, float& dist_sqr) const {

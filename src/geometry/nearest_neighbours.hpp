@@ -34,6 +34,12 @@ class NearestNeighbours {
   /// for ties. A hint of -1 (or a non-finite point) is no hint.
   int nearest(const Eigen::Vector3f& q, int hint, float& dist_sqr) const;
 
+  /// nearest(), for a caller that needs no point farther than `max_dist` (a distance it caps
+  /// there): -1 and infinity when none lies within it. The grids' rings decide that, so a
+  /// query far from every point costs no whole-cloud scan when max_dist is at most kMaxRing
+  /// coarse cells.
+  int nearestWithin(const Eigen::Vector3f& q, float max_dist, float& dist_sqr) const;
+
   /// Indices of the points within `radius` of q (squared distance <= radius^2), appended to
   /// `out` in no particular order. Scans the fine grid's cells that the ball overlaps, so a
   /// cell about the radius's size suits (MLS's neighbourhoods).
@@ -67,6 +73,9 @@ class NearestNeighbours {
     float cell = 1.f, inv_cell = 1.f;
     int nx = 0, ny = 0, nz = 0;
   };
+
+  /// The nearest point (an index into points_) if it lies within sqrt(bound_sqr), else -1.
+  int search(const Eigen::Vector3f& q, float bound_sqr, float& dist_sqr) const;
 
   PointCloud points_;  // the finite points, in the fine grid's order
   std::vector<int> original_;  // points_[i] was points[original_[i]]

@@ -56,7 +56,10 @@ PointCloud sampleSurface(const Mesh& mesh, int count, unsigned seed) {
 /// whose points lie farther is no symmetry whatever the exact figure).
 class CappedDistance {
  public:
-  CappedDistance(const PointCloud& surface, float cap) : surface_(surface), index_(surface, 0.5f * cap), cap_(cap) {}
+  /// The index's coarse grid settles every query within the cap (its reach is kMaxRing coarse
+  /// cells), so a turned point far from the surface costs no scan of the whole surface.
+  CappedDistance(const PointCloud& surface, float cap)
+      : index_(surface, cap / (NearestNeighbours::kMaxRing * NearestNeighbours::kCoarse)), cap_(cap) {}
 
   /// The `share` quantile of the distances from `points`, turned, to the surface; cap_ when
   /// at least that share lies farther. Checks a first slice of the points and gives up early
@@ -73,12 +76,9 @@ class CappedDistance {
   }
 
  private:
-  float nearest(const Eigen::Vector3f& q) {
-    found_.clear();
-    index_.within(q, cap_, found_);
-    float best = cap_ * cap_;
-    for (const int k : found_) best = std::min(best, (surface_[static_cast<std::size_t>(k)] - q).squaredNorm());
-    return std::sqrt(best);
+  float nearest(const Eigen::Vector3f& q) const {
+    float d_sqr = 0.f;
+    return index_.nearestWithin(q, cap_, d_sqr) < 0 ? cap_ : std::sqrt(d_sqr);
   }
   static float quantileOf(std::vector<float> d, float share) {
     if (d.empty()) return 0.f;
@@ -86,10 +86,8 @@ class CappedDistance {
     std::nth_element(d.begin(), k, d.end());
     return *k;
   }
-  PointCloud surface_;
   NearestNeighbours index_;
   float cap_;
-  std::vector<int> found_;
 };
 
 }  // namespace

@@ -449,6 +449,43 @@ TEST(NearestNeighbours, FindTheSamePointsAsPclsKdTreeAndABruteForceScan) {
       }
     }
     EXPECT_GE(hinted, 5 * (queries.size() - 1) - 10);  // the same point but for ties
+
+    // Within a distance (the symmetry search's capped distances): the nearest point when it
+    // lies within, else -1; no whole-cloud scan while the distance is within the coarse
+    // grid's reach (a smaller grid than max_cells asks for has larger cells).
+    std::size_t within_scans = 0;
+    const float coarse_reach = NearestNeighbours::kMaxRing * NearestNeighbours::kCoarse * 0.004f;
+    for (const float max_dist : {0.f, 0.003f, 0.012f, coarse_reach}) {
+      std::size_t inside = 0;
+      for (const auto& q : queries) {
+        float d = 0.f, plain_d = 0.f;
+        const std::size_t scans_before = grid.fullScans();
+        const int found = grid.nearestWithin(q, max_dist, d);
+        within_scans += grid.fullScans() - scans_before;
+        const int plain = grid.nearest(q, plain_d);
+        if (plain >= 0 && plain_d <= max_dist * max_dist) {
+          ++inside;
+          EXPECT_EQ(d, plain_d) << "within " << max_dist;
+          ASSERT_GE(found, 0);
+          EXPECT_EQ((with_bad[static_cast<std::size_t>(found)] - q).squaredNorm(), d);
+        } else {
+          EXPECT_EQ(found, -1) << "within " << max_dist;
+          EXPECT_EQ(d, std::numeric_limits<float>::infinity());
+        }
+      }
+      if (max_dist >= 0.012f) {
+        EXPECT_GT(inside, 1000u);  // both answers were asked for
+      }
+      if (max_dist > 0.f && max_dist < coarse_reach) {
+        EXPECT_LT(inside, queries.size() - 100);
+      }
+    }
+    float d = 0.f;
+    EXPECT_EQ(grid.nearestWithin(queries[0], -1.f, d), -1);
+    EXPECT_EQ(grid.nearestWithin(queries[0], std::nanf(""), d), -1);
+    if (max_cells > 64) {
+      EXPECT_EQ(within_scans, 0u);
+    }
   }
   float d = 0.f;
   EXPECT_EQ(NearestNeighbours({}, 0.004f).nearest(Eigen::Vector3f(0.f, 0.f, 1.f), d), -1);
