@@ -13,14 +13,22 @@ uvec4 grid(uint invocations) {
   return uvec4(max(min(n, kGridColumns), 1u), (n + kGridColumns - 1u) / kGridColumns, 1u, 0u);
 }
 void main() {
+  // Once the pass has overflowed the candidate list or a chunk's units, it is read back only
+  // for its counts and run again (Similarity::read): the refinement of the chunks after that
+  // is skipped (zero-sized dispatches), so a pass that finds the sizes costs about its
+  // coarse level. The counts go on: the candidates' from each coarse pass, the units' from
+  // every chunk whose candidates were all listed.
+  bool overflowed = count > pc.candidate_capacity || max_units > pc.unit_capacity;
   if (pc.stage == 0u) {
     uint end = min(count, pc.candidate_capacity);
     first_candidate = next_candidate;
     next_candidate = end;
-    candidate_groups = grid(end - first_candidate);
+    candidate_groups = grid(overflowed ? 0u : end - first_candidate);
   } else {
     max_units = max(max_units, unit_count);
+    overflowed = overflowed || max_units > pc.unit_capacity;
     for (int span = 1; span <= kMaxSpan; ++span)
-      run_groups[span - 1] = grid(min(run_count[span - 1], runCapacity(pc.unit_capacity, span)));
+      run_groups[span - 1] = grid(overflowed ? 0u : min(run_count[span - 1], runCapacity(pc.unit_capacity, span)));
+    if (overflowed) candidate_groups = grid(0u);  // nor selected
   }
 }

@@ -271,7 +271,10 @@ bool Similarity::read(std::vector<match::CoarseCandidate>& candidates, std::vect
   if (layouts_.size() > 1) {
     const uint32_t max_units = static_cast<const uint32_t*>(state_.mapped())[1];
     if (max_units > unit_capacity_) {
-      units_full_ = unit_capacity_ == max_unit_capacity_;
+      // A chunk's units are counted only while its candidates all fit, so the count is
+      // exact: more than a binding holds means smaller chunks now, not after a pass at the
+      // largest capacity.
+      units_full_ = unit_capacity_ == max_unit_capacity_ || max_units > max_unit_capacity_;
       unit_capacity_ = std::min(std::max(max_units + max_units / 4, unit_capacity_ * 2), max_unit_capacity_);
       complete = false;
     }
