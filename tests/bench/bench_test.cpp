@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <thread>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -85,8 +84,7 @@ std::string smallBoxBank() {
     params.views.radii = {0.6f, 0.7f, 0.1f};
     params.views.inplane_deg = {-10.f, 10.f, 10.f};
     params.camera.cx = 319.5, params.camera.cy = 239.5;
-    const std::string p = (std::filesystem::temp_directory_path() /
-                           ("vkpose_bench_box_" + std::to_string(::getpid()) + ".vkpb")).string();
+    const std::string p = test::scratchDir("vkpose_bench_") + "/box.vkpb";
     saveBank(trainTemplates(test::context(), box, params), p);
     return p;
   }();

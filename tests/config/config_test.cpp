@@ -9,8 +9,8 @@
 #include <variant>
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
+#include "test_support.hpp"
 #include "vkpose/config.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/synth.hpp"
@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("vkpose_config_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir = test::scratchDir("vkpose_config_" + name + "_");
   fs::remove_all(dir);
   return dir;
 }

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -26,7 +25,7 @@ constexpr int kImages = 4;
 /// Four 320x240 images of the L-shaped part (2-3 instances each, clutter), written once.
 const std::string& slicesDataset() {
   static const std::string dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("vkpose_eval_slices_" + std::to_string(::getpid()));
+    const fs::path d = test::scratchDir("vkpose_eval_slices_");
     fs::remove_all(d);
     fs::create_directories(d / "meshes");
     const std::string ply = (d / "meshes" / "l_part.ply").string();

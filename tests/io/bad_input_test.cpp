@@ -13,7 +13,6 @@
 #include <functional>
 #include <sstream>
 
-#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -57,11 +56,7 @@ std::vector<LinemodTemplate> someTemplates() {
 }
 
 /// A folder of this test process (ctest runs tests in parallel processes).
-std::string scratch() {
-  const auto dir = std::filesystem::temp_directory_path() / ("vkpose_bad_input_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
+std::string scratch() { return test::scratchDir("vkpose_bad_input_"); }
 
 std::string writeFile(const std::string& name, const std::string& bytes) {
   const std::string path = scratch() + "/" + name;

@@ -8,7 +8,6 @@
 #include <string>
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "hypotheses/cluster_score.hpp"
 #include "match/matcher.hpp"
@@ -27,7 +26,7 @@ namespace vkpose {
 namespace {
 
 std::string writeInput(const std::string& name, const std::string& bytes) {
-  const std::string path = ::testing::TempDir() + "/fuzz_" + std::to_string(::getpid()) + "_" + name;
+  const std::string path = test::scratchDir("vkpose_fuzz_") + "/" + name;
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
   return path;
 }

@@ -6,6 +6,8 @@
 #include <random>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include "match/features.hpp"
 #include "match/matcher.hpp"
 #include "match/opencv_linemod.hpp"
@@ -29,6 +31,26 @@ std::string sharedData() {
 TemplateBank cachedBank(const Mesh& mesh, const TrainingParams& params) {
   return loadOrTrainBank(context(), mesh, params, sampleViews(params.views, mesh.bboxCentre()), VKPOSE_TEST_CACHE_DIR)
       .bank;
+}
+
+namespace {
+/// The scratch folders made by this process, removed at its exit.
+struct ScratchFolders {
+  std::vector<std::filesystem::path> made;
+  ~ScratchFolders() {
+    for (const auto& dir : made) {
+      std::error_code ignored;  // a folder already gone is fine
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+};
+}  // namespace
+
+std::string scratchDir(const std::string& prefix) {
+  static ScratchFolders folders;
+  const auto dir = std::filesystem::temp_directory_path() / (prefix + std::to_string(::getpid()));
+  if (std::filesystem::create_directories(dir)) folders.made.push_back(dir);
+  return dir.string();
 }
 
 bool haveSharedData() { return std::filesystem::exists(sharedData() + "/lmo_scene2_frame3/test/000002/rgb/000003.png"); }

@@ -19,6 +19,10 @@ namespace vkpose::test {
 
 std::string sharedData();  ///< ../shared/data (VKPOSE_SHARED_DATA_DIR), or $VKPOSE_TEST_SHARED_DATA where set
 bool haveSharedData();
+/// A folder of this test process under the temporary directory, named `prefix` and the
+/// process id (ctest runs tests in parallel processes); removed with what it holds when the
+/// process exits, so test runs leave nothing behind.
+std::string scratchDir(const std::string& prefix);
 
 /// The real frames the parity tests use: LM-O scene 2 frame 3 and IC-BIN scene 2 frame 0.
 LinemodFrame lmoFrame();

@@ -10,7 +10,6 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
-#include <unistd.h>
 
 #include "mesh_support.hpp"
 #include "synth/placement.hpp"
@@ -28,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("vkpose_synth_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir = test::scratchDir("vkpose_synth_" + name + "_");
   fs::remove_all(dir);
   return dir;
 }
