@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,13 @@ std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m
 /// deviation, at most `max_count`. The detector refits each after ICP and lets depth (and
 /// colour) choose (VerifyParams::look_alike_tolerance). Empty when to_m <= from_m.
 std::vector<NearSymmetry> findLookAlikeTurns(const Mesh& mesh, float from_m, float to_m, int max_count = 3);
+
+/// A body of revolution found in its near-symmetries, whether or not the bank was trained
+/// `--symmetric` (a lidded cup): the first of them about an axis that has both a turn of a
+/// sixth (60, 120, 240 or 300 degrees) and one of a quarter (90 or 270), so at least 12-fold.
+/// None otherwise: a box passes only quarters, a hexagonal nut only sixths. Its axis and point
+/// are the axis of revolution.
+std::optional<NearSymmetry> revolutionAxis(const std::vector<NearSymmetry>& symmetries);
 
 /// "180 deg about (0.00, 0.00, 1.00)" for messages.
 std::string describe(const NearSymmetry& s);

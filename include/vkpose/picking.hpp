@@ -98,9 +98,10 @@ const char* pickOrderName(PickOrder order);
 
 struct PickParams {
   PickOrder order = PickOrder::Combined;
-  /// The direction the robot approaches along, camera frame: the camera's viewing direction
-  /// (it looks into the bin) unless the robot's axis is given.
-  Eigen::Vector3f approach_axis = Eigen::Vector3f::UnitZ();
+  /// The direction the robot approaches along, camera frame, where the robot's axis is given.
+  /// Otherwise straight down into the bin (against its floor's normal) when there is a bin,
+  /// else the camera's viewing direction (approachAxis()).
+  std::optional<Eigen::Vector3f> approach_axis;
   float max_tilt_deg = 45.f;  ///< grasps whose approach is tilted further from that axis are refused
   /// Scene points inside the swept gripper that refuse a grasp (fewer are noise).
   int min_blocking_points = 12;
@@ -159,6 +160,11 @@ struct PickPlan {
 PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<TemplateBank>& banks,
                    const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
                    const std::optional<BinBox>& bin, const PickParams& params);
+
+/// The approach axis a plan measures tilts from (unit, camera frame): the given one, else into
+/// the bin (a robot reaches down into it wherever the camera looks from), else the camera's
+/// viewing direction. InputError for a given axis of zero length.
+Eigen::Vector3f approachAxis(const PickParams& params, const std::optional<BinBox>& bin);
 
 /// One instance of a scene whose truth is known (a synthetic frame's ground truth).
 struct TruthInstance {

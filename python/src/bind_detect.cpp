@@ -639,7 +639,7 @@ detection {"valid": [...], "refused": [{"name", "reason"}]}], "picks": [{"detect
 
 grasps: a grasp file or a list of them. depth: the frame's depth (as detect() took it). bin: a
 bin file. order: combined, height, score or visible. max_tilt: degrees from approach_axis
-(default the camera's viewing direction, (0, 0, 1)).)");
+(default: down into the bin, or the camera's viewing direction (0, 0, 1) without one).)");
 }
 
 }  // namespace vkpose::python

@@ -421,7 +421,8 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->group(picking);
   sub->add_option("--approach-axis", opt->approach_axis,
-                  "The robot's approach direction in the camera frame, 3 numbers (default 0 0 1: along the camera's view)")
+                  "The robot's approach direction in the camera frame, 3 numbers (default: down into the --bin, or 0 0 1 along "
+                  "the camera's view without one)")
       ->expected(3)
       ->group(picking);
   return [opt, &global]() {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -289,19 +291,30 @@ float rankOf(const Pick& p, PickOrder order) {
 
 std::vector<Grasp> expandBySymmetry(const std::vector<Grasp>& grasps, const TemplateBank& bank, int steps) {
   std::vector<Pose> turns = {Pose{}};
+  // Continuous about the axis of revolution: the up axis of a bank trained --symmetric, through
+  // a near-symmetry's point on that axis when the bank found one (the true axis), else through
+  // the bank's centre; or the axis of a body of revolution that no flag declared (a lidded cup
+  // passes the turns of both a hexagon and a square about its axis).
+  std::optional<std::pair<Eigen::Vector3f, Eigen::Vector3f>> axis;  // direction, point
   if (bank.symmetric) {
-    // Continuous about the up axis; through a near-symmetry's point on that axis when the
-    // bank found one (the true axis), else through the bank's centre.
     const Eigen::Vector3f up = bank.params.views.up.normalized();
     Eigen::Vector3f point = bank.centre;
     for (const NearSymmetry& s : bank.near_symmetries)
       if (std::abs(s.axis.normalized().dot(up)) > 0.99f) point = s.point;
-    for (int k = 1; k < std::max(1, steps); ++k) {
-      const Eigen::Matrix3f R = axisAngle(up, 2 * std::numbers::pi_v<float> * static_cast<float>(k) / static_cast<float>(steps));
-      turns.push_back({R, point - R * point});
-    }
+    axis = {up, point};
   }
-  for (const NearSymmetry& s : bank.near_symmetries) turns.push_back(s.transform());
+  const std::optional<NearSymmetry> revolution =
+      bank.symmetric ? std::nullopt : revolutionAxis(bank.near_symmetries);
+  if (revolution) axis = {revolution->axis.normalized(), revolution->point};
+  if (axis)
+    for (int k = 1; k < std::max(1, steps); ++k) {
+      const Eigen::Matrix3f R =
+          axisAngle(axis->first, 2 * std::numbers::pi_v<float> * static_cast<float>(k) / static_cast<float>(steps));
+      turns.push_back({R, axis->second - R * axis->second});
+    }
+  for (const NearSymmetry& s : bank.near_symmetries)
+    if (!revolution || std::abs(s.axis.normalized().dot(revolution->axis.normalized())) < 0.9999f)
+      turns.push_back(s.transform());  // the turns about the axis of revolution are copies above
   std::vector<Grasp> out;
   for (const Grasp& g : grasps)
     for (const Pose& turn : turns) {
@@ -371,13 +384,23 @@ std::string refusal(PlacedGrasp& p, const Grasp& g, const GraspSurroundings& at)
 
 }  // namespace
 
+Eigen::Vector3f approachAxis(const PickParams& params, const std::optional<BinBox>& bin) {
+  if (params.approach_axis) {
+    if (!(params.approach_axis->norm() > 0.f) || !params.approach_axis->allFinite())
+      throw InputError("the approach axis must be a finite direction, not zero");
+    return params.approach_axis->normalized();
+  }
+  if (bin) return -bin->pose.R.col(2).normalized();  // the bin's z is up, out of it
+  return Eigen::Vector3f::UnitZ();
+}
+
 PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<TemplateBank>& banks,
                    const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
                    const std::optional<BinBox>& bin, const PickParams& params) {
   if (!depth_m.empty() && depth_m.type() != CV_32F) throw InputError("planPicks: the depth must be metres (CV_32F)");
   if (!(params.max_tilt_deg > 0.f && params.max_tilt_deg <= 180.f))
     throw InputError(fmt::format("the largest approach tilt must be in (0, 180] degrees, not {}", params.max_tilt_deg));
-  if (!(params.approach_axis.norm() > 0.f)) throw InputError("the approach axis must not be zero");
+  const Eigen::Vector3f approach_axis = approachAxis(params, bin);
   PickPlan plan;
   plan.detections.resize(detections.size());
   // Each detection's surface, about 3 mm apart (small parts 1/30 of their size).
@@ -405,7 +428,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
     std::vector<std::string> order;
     for (const Grasp& g : grasps[b]) {
       if (!copies.count(g.name)) order.push_back(g.name);
-      copies[g.name].push_back(placeGrasp(g, d.pose, params.approach_axis));
+      copies[g.name].push_back(placeGrasp(g, d.pose, approach_axis));
       sources[g.name].push_back(&g);
     }
     DetectionGrasps& out = plan.detections[i];

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <random>
 
 #include <Eigen/Eigenvalues>
@@ -167,6 +168,31 @@ std::vector<NearSymmetry> findTurns(const Mesh& mesh, const std::vector<float>& 
 
 std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count) {
   return findTurns(mesh, {kAngles.begin(), kAngles.end()}, -1.f, tolerance_m, max_count);
+}
+
+std::optional<NearSymmetry> revolutionAxis(const std::vector<NearSymmetry>& symmetries) {
+  // The search turns about a few fixed axes, so the turns of one axis share its direction and
+  // point exactly (bank files keep them bit for bit); a little slack costs nothing.
+  auto sameAxis = [](const NearSymmetry& a, const NearSymmetry& b) {
+    return std::abs(a.axis.normalized().dot(b.axis.normalized())) > 0.9999f && (a.point - b.point).norm() < 1e-5f;
+  };
+  auto isAny = [](float angle, std::initializer_list<float> of) {
+    return std::any_of(of.begin(), of.end(), [&](float a) { return std::abs(angle - a) < 0.5f; });
+  };
+  // A turn of a sixth and one of a quarter about the same axis make a turn of a twelfth: at
+  // least 12-fold, which no mesh is short of a body of revolution. Checked this way because a
+  // bank keeps only its few closest near-symmetries, which for a can include its half-turns
+  // end for end, crowding out some of the turns about its axis.
+  for (const NearSymmetry& s : symmetries) {
+    bool sixth = false, quarter = false;
+    for (const NearSymmetry& o : symmetries) {
+      if (!sameAxis(s, o)) continue;
+      sixth = sixth || isAny(o.angle_deg, {60.f, 120.f, 240.f, 300.f});
+      quarter = quarter || isAny(o.angle_deg, {90.f, 270.f});
+    }
+    if (sixth && quarter) return s;
+  }
+  return std::nullopt;
 }
 
 std::vector<NearSymmetry> findLookAlikeTurns(const Mesh& mesh, float from_m, float to_m, int max_count) {

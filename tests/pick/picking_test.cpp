@@ -104,6 +104,78 @@ TEST(Picking, ASymmetricPartsGraspIsOfferedAtEveryAngleItLiesAt) {
   EXPECT_NE(without.detections[0].refused[0].reason.find("tilted"), std::string::npos);
 }
 
+TEST(Picking, ABodyOfRevolutionTrainedWithoutTheFlagGetsEveryAngleToo) {
+  // The can again, its bank not --symmetric: the training's near-symmetries (every turn about
+  // its axis) show it is a body of revolution, so its grasp is copied all round as well.
+  TemplateBank bank = canBank();
+  bank.symmetric = false;
+  bank.near_symmetries = findNearSymmetries(bank.mesh, 0.03f * bank.diameter);
+  const auto axis = revolutionAxis(bank.near_symmetries);
+  ASSERT_TRUE(axis.has_value());
+  EXPECT_GT(std::abs(axis->axis.normalized().z()), 0.99f);
+  const std::vector<Grasp> side = parseGrasps(kSideGrasp, "can.json").grasps;
+  const std::vector<Grasp> expanded = expandBySymmetry(side, bank, 36);
+  PickParams params;
+  for (int roll = 0; roll < 360; roll += 25) {
+    const PickPlan plan =
+        planPicks({detectionAt(lyingCan(static_cast<float>(roll)))}, {bank}, {expanded}, cv::Mat(), camera(),
+                  std::nullopt, params);
+    ASSERT_EQ(plan.picks.size(), 1u) << "roll " << roll;
+    EXPECT_LE(plan.picks[0].grasp.tilt_deg, 5.5f) << "roll " << roll;
+  }
+  // A square prism passes 90, 180 and 270 degrees about its axis, not 60 or 120: no body of
+  // revolution, and its grasps are copied by those turns alone.
+  TemplateBank prism = bank;
+  prism.mesh = test::boxMesh({0.06f, 0.06f, 0.1f});
+  prism.near_symmetries = findNearSymmetries(prism.mesh, 0.03f * prism.mesh.diameter);
+  EXPECT_FALSE(prism.near_symmetries.empty());
+  EXPECT_FALSE(revolutionAxis(prism.near_symmetries).has_value());
+  EXPECT_EQ(expandBySymmetry(side, prism, 36).size(), 1 + prism.near_symmetries.size());
+  // Nor is a hexagonal prism (sixths only).
+  Mesh hexagon = procedural::lathe({{0.f, -0.05f}, {0.04f, -0.05f}, {0.04f, 0.05f}, {0.f, 0.05f}}, 6, {0.5f, 0.5f, 0.5f});
+  finishMesh(hexagon);
+  const auto hex_turns = findNearSymmetries(hexagon, 0.03f * hexagon.diameter);
+  EXPECT_FALSE(hex_turns.empty());
+  EXPECT_FALSE(revolutionAxis(hex_turns).has_value());
+}
+
+TEST(Picking, TiltIsMeasuredDownIntoTheBinWhereThereIsOne) {
+  // A bin seen at 30 degrees (its z, up out of it, tilted towards the camera) and a can
+  // standing on its floor, taken by a suction cup on its lid straight down into the bin.
+  BinBox bin;
+  bin.pose.R = Eigen::AngleAxisf(150.f * 3.14159265f / 180.f, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  bin.pose.t = {0.f, 0.f, 0.9f};
+  EXPECT_NEAR(approachAxis({}, bin).dot(-bin.pose.R.col(2)), 1.f, 1e-6f);
+  EXPECT_EQ(approachAxis({}, std::nullopt), Eigen::Vector3f::UnitZ());
+  PickParams given;
+  given.approach_axis = Eigen::Vector3f(0.f, 0.f, 2.f);  // the robot's axis wins, as a unit vector
+  EXPECT_NEAR((approachAxis(given, bin) - Eigen::Vector3f::UnitZ()).norm(), 0.f, 1e-6f);
+  given.approach_axis = Eigen::Vector3f::Zero();
+  EXPECT_NE(test::inputErrorOf([&] { approachAxis(given, bin); }).find("approach axis"), std::string::npos);
+
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> top = parseGrasps(R"({"object": "can",
+    "gripper": {"shape": "cylinder", "radius_mm": 15, "length_mm": 120},
+    "grasps": [{"name": "top", "position_mm": [0, 0, 50], "approach": [0, 0, -1], "x": [1, 0, 0],
+                "approach_distance_mm": 80, "retreat_distance_mm": 80, "suction_radius_mm": 10}]})",
+                                             "can.json")
+                                     .grasps;
+  Pose standing;
+  standing.R = bin.pose.R;
+  standing.t = bin.pose.t + bin.pose.R * Eigen::Vector3f(0.f, 0.f, 0.0505f);
+  PickParams params;
+  params.max_tilt_deg = 20.f;
+  const PickPlan in_bin = planPicks({detectionAt(standing)}, {bank}, {top}, cv::Mat(), camera(), bin, params);
+  ASSERT_EQ(in_bin.picks.size(), 1u);
+  EXPECT_LT(in_bin.picks[0].grasp.tilt_deg, 0.1f);
+  // Measured from the camera's view instead, the same grasp is 30 degrees off, and refused.
+  params.approach_axis = Eigen::Vector3f::UnitZ();
+  const PickPlan from_camera = planPicks({detectionAt(standing)}, {bank}, {top}, cv::Mat(), camera(), bin, params);
+  EXPECT_TRUE(from_camera.picks.empty());
+  ASSERT_EQ(from_camera.detections[0].refused.size(), 1u);
+  EXPECT_NE(from_camera.detections[0].refused[0].reason.find("tilted 30 degrees"), std::string::npos);
+}
+
 TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
