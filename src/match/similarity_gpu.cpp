@@ -15,6 +15,7 @@ namespace {
 // are gpu/kernel_interface.h's, shared with the shaders.
 static_assert(kCoarseRows == match::kStripRows && 16 * kCoarseSpan == match::kStripColumns,
               "depth pruning skips what one coarse invocation scores");
+constexpr std::size_t kFirstCandidatesPerTemplate = 32;  // candidates and refined: 32 bytes each
 constexpr std::size_t kUnitScoreBytes = 32 * kUnitBand;  // 16 packed 16-bit scores per row
 // State buffer (REFINE_STATE in refine_grid.glsl): unit count, most units of a chunk, next
 // and this chunk's first candidate, the indirect dispatch sizes over the chunk's candidates
@@ -120,7 +121,11 @@ void Similarity::setTemplates(Batch& batch, const std::vector<LinemodTemplate>& 
   // find more candidates than one binding holds, and then the matcher splits the chunks into
   // passes, so chunks are kept to 16384 templates for the split to have something to split.
   max_capacity_ = static_cast<uint32_t>(std::min<std::size_t>((dev.max_storage_buffer_range - 16) / 16, 1u << 30));
-  capacity_ = std::min(capacity_, max_capacity_);
+  // A first frame whose candidates overflow the list runs its coarse level again: start with
+  // room for as many as real frames give (IC-BIN's cup: 15 a template; LM-O's clutter: 70),
+  // 1 KB a template at most.
+  capacity_ = static_cast<uint32_t>(std::min<std::size_t>(
+      std::max<std::size_t>(capacity_, kFirstCandidatesPerTemplate * templates.size()), max_capacity_));
   const std::size_t max_templates = chunk_templates_;
   std::size_t units_per_template = 0, binding_units = 0;
   if (levels > 1) {
