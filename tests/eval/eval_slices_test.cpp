@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 
-
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 

@@ -13,7 +13,6 @@
 #include <functional>
 #include <sstream>
 
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
