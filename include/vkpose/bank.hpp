@@ -153,11 +153,16 @@ std::string describe(const NearSymmetry& s);
 std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const Eigen::Vector3f& up,
                                              const std::vector<NearSymmetry>& symmetries);
 
+/// Training nearer than this (the nearest of --radii, metres) is a bin-picking cell's working
+/// distance: whatever the part's size, it lies in a pile any way up (a 17 cm spark-plug key on
+/// its side), so `--resting auto` trains every resting pose.
+inline constexpr float kPileDistanceM = 0.5f;
+
 /// Whether training covers the other resting poses: `resting` is "all", "up" or "auto" (all for
-/// a part smaller than kSmallPartDiameterM, config.hpp: parts of a few centimetres are picked
-/// from bins and lie any way up, while larger objects mostly stand). Throws InputError for
-/// anything else.
-bool trainsOtherRestingPoses(const std::string& resting, float diameter_m);
+/// a part smaller than kSmallPartDiameterM, config.hpp, or trained nearer than kPileDistanceM:
+/// parts picked from bins lie any way up, while larger objects seen from farther mostly stand).
+/// Throws InputError for anything else.
+bool trainsOtherRestingPoses(const std::string& resting, float diameter_m, float nearest_distance_m);
 
 /// One training view: the object-to-camera pose (x_cam = R x_obj + t) that puts `centre`
 /// (in object coordinates) on the optical axis at `distance`.
@@ -241,6 +246,33 @@ struct TrainingParams {
 
 /// Throws InputError naming the bad value.
 void validateTrainingParams(const TrainingParams& params);
+
+/// A part across fewer cells of LINEMOD's coarsest level than this at the nearest training
+/// distance is too small to tell from its neighbourhood: its few features fit any screw head or
+/// part end (an 11 mm nut at 0.36 m, 1.1 cells, fired on screw heads all over a real pile).
+/// `vkpose train` refuses it unless --allow-small.
+inline constexpr float kMinPartCells = 2.f;
+
+/// How large the part looks where it is trained and what the sensor resolves there, the
+/// evidence a detection of it can have (`vkpose train` prints summary()).
+struct PartSizeEvidence {
+  float diameter_m = 0.f, thinnest_m = 0.f;  ///< largest and smallest extent (bounding box side)
+  float nearest_m = 0.f, farthest_m = 0.f;   ///< training distances
+  float pixels_near = 0.f, pixels_far = 0.f;  ///< the diameter in pixels at each
+  float cells_near = 0.f, cells_far = 0.f;    ///< the same in cells of LINEMOD's coarsest level
+  float thin_pixels_far = 0.f;                ///< the thinnest extent in pixels at the farthest
+  float pixel_mm_near = 0.f, pixel_mm_far = 0.f;  ///< what one pixel spans there, millimetres
+  /// Under kMinPartCells at the nearest distance.
+  bool too_small() const { return cells_near < kMinPartCells; }
+  /// Thinner than a structured-light or stereo sensor's matching window resolves (about 4
+  /// pixels, half a 7-9 pixel window): its depth merges into what lies behind it.
+  bool thin_in_depth() const { return thin_pixels_far < 4.f; }
+  /// One or two sentences for `vkpose train`.
+  std::string summary() const;
+  /// Why training refuses it (too_small()), with what to do instead.
+  std::string refusal() const;
+};
+PartSizeEvidence partSizeEvidence(const Mesh& mesh, const TrainingParams& params);
 
 /// What a user should know before training `mesh` with `params`, one sentence each (empty:
 /// nothing): today, an object under about 2.5 cells of LINEMOD's coarsest level across at the

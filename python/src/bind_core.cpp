@@ -212,7 +212,7 @@ void bindCore(py::module_& m) {
       [](const py::object& mesh_path, const std::string& units, int views, const py::object& radii,
          const py::object& inplane, const std::string& hemisphere, float max_view_angle, int features,
          const py::object& camera, bool symmetric, const std::string& up, const std::string& resting,
-         const py::object& device,
+         bool allow_small, const py::object& device,
          const py::object& cache_dir, const py::object& progress) {
         TrainingParams params;
         params.views.viewpoints = views;
@@ -238,6 +238,8 @@ void bindCore(py::module_& m) {
           py::gil_scoped_release nogil;
           return loadMesh(path, mesh_units);
         }();
+        if (const PartSizeEvidence size = partSizeEvidence(mesh, params); size.too_small() && !allow_small)
+          valueError(size.refusal() + " (allow_small=True in Python)");
         for (const std::string& w : trainingWarnings(mesh, params))
           if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
         const auto report = progressOf(progress, "training");
@@ -254,7 +256,8 @@ void bindCore(py::module_& m) {
       py::arg("mesh"), py::kw_only(), py::arg("units") = "auto", py::arg("views") = 216,
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
-      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "auto", py::arg("device") = py::none(),
+      py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "auto",
+      py::arg("allow_small") = false, py::arg("device") = py::none(),
       py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
@@ -269,7 +272,9 @@ symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end 
 +z first) or '+x', '-x', '+y', '-y', '+z', '-z'; views are sampled above it. resting: 'up' (views about
 the up axis only), 'all' (also a hemisphere about each other pose it rests in, lying or upside
 down, that no near-symmetry covers: up to 6x the templates) or 'auto' (all for a part smaller
-than 10 cm across, up otherwise). device: None, an index or a Device. cache_dir: a folder
+than 10 cm across or trained nearer than 0.5 m, up otherwise). allow_small: train a part under
+2 cells of LINEMOD's coarsest level across at the nearest radius, which raises ValueError
+otherwise (too small to tell from its neighbourhood). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

@@ -160,13 +160,16 @@ def test_training_checks_its_arguments_before_any_work(tmp_path):
         vkpose.train(mesh, resting="sideways")
 
 
-def test_training_warns_when_the_object_is_too_small_for_linemod():
-    # The demo's bracket (136 mm) at 4 m: 20 pixels, 0.5 cells of the coarse level. Training may
-    # then find too few features in every view; either way the warning came first.
+def test_training_refuses_an_object_too_small_for_linemod_unless_allowed():
+    # The demo's bracket (136 mm) at 4 m: 20 pixels, 0.5 cells of the coarse level, under the 2
+    # a part needs: refused. Allowed, training warns; it may then find too few features in
+    # every view, and either way the warning came first.
     mesh = REPO / "assets" / "meshes" / "angle_bracket.ply"
+    with pytest.raises(ValueError, match="allow_small"):
+        vkpose.train(mesh, units="mm", views=2, radii=4.0, inplane=0)
     with pytest.warns(UserWarning, match="cells of LINEMOD's coarsest level"):
         try:
-            vkpose.train(mesh, units="mm", views=2, radii=4.0, inplane=0)
+            vkpose.train(mesh, units="mm", views=2, radii=4.0, inplane=0, allow_small=True)
         except ValueError:
             pass
 

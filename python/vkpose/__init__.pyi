@@ -113,7 +113,8 @@ def train(mesh: PathLike, *, units: str = "auto", views: int = 216,
           radii: str | float | tuple[float, float, float] = "0.6:1.0:0.1",
           inplane: str | float | tuple[float, float, float] = "-60:60:10", hemisphere: str = "upper",
           max_view_angle: float = 180.0, features: int = 63, camera: CameraArg | None = None,
-          symmetric: bool = False, up: str = "auto", resting: str = "auto", device: DeviceArg = None, cache_dir: PathLike | None = None,
+          symmetric: bool = False, up: str = "auto", resting: str = "auto", allow_small: bool = False,
+          device: DeviceArg = None, cache_dir: PathLike | None = None,
           progress: Progress = None) -> Bank:
     """Renders a mesh from every training view and returns its template bank."""
 

@@ -22,7 +22,7 @@ struct TrainOptions {
       up = "auto", resting = "auto";
   int views = 216, features = 63;
   float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
-  bool symmetric = false, force = false;
+  bool symmetric = false, force = false, allow_small = false;
 };
 
 const char* unitName(MeshUnits u) { return u == MeshUnits::Millimetres ? "millimetres" : "metres"; }
@@ -59,12 +59,27 @@ void printPlan(const TrainingPlan& plan, const TrainingParams& params, const Mes
     fmt::print("other resting poses: {} ({})\n", restingUpsText(plan.other_ups),
                plan.other_ups.empty() ? "it stands on no other side, or near-symmetries cover them"
                : trained && opt.resting == "auto"
-                   ? fmt::format("a hemisphere of views about each as well: a part {:.0f} mm across lies any way up "
-                                 "in a bin; --resting up trains it standing only",
-                                 1e3f * mesh.diameter)
+                   ? fmt::format("a hemisphere of views about each as well: {} lies any way up in a bin; --resting "
+                                 "up trains it standing only",
+                                 isSmallPart(mesh.diameter)
+                                     ? fmt::format("a part {:.0f} mm across", 1e3f * mesh.diameter)
+                                     : fmt::format("a part seen from {:.2f} m (nearer than {:.1f} m: bin picking)",
+                                                   std::min(params.views.radii.from, params.views.radii.to),
+                                                   kPileDistanceM))
                : trained ? "a hemisphere of views about each as well"
                      : "not trained: pass --resting all to find it lying down too");
   }
+}
+
+/// Templates without a depth feature although the bank was trained with depth.
+std::size_t colourOnlyTemplates(const TemplateBank& bank) {
+  if (!bank.params.features.use_depth) return 0;
+  return static_cast<std::size_t>(std::count_if(bank.templates.begin(), bank.templates.end(), [](const BankTemplate& t) {
+    for (const auto& level : t.linemod.levels)
+      for (const auto& f : level.features)
+        if (f.modality == Modality::DepthNormal) return false;
+    return true;
+  }));
 }
 
 /// `vkpose train`.
@@ -82,6 +97,9 @@ ExitCode runTrain(const TrainOptions& opt, const GlobalOptions& global) {
                  unitName(report.units), report.file_diameter);
     fmt::print("diameter: {:.4f} m\n", mesh.diameter);
   }
+  const PartSizeEvidence size = partSizeEvidence(mesh, params);
+  if (size.too_small() && !opt.allow_small) throw InputError(size.refusal());
+  if (!global.quiet) fmt::print("size: {}\n", size.summary());
   for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
   const TrainingPlan plan = planTraining(mesh, params, opt.up == "auto", opt.resting, opt.max_view_angle);
   printPlan(plan, params, mesh, opt, global.verbose);
@@ -97,6 +115,9 @@ ExitCode runTrain(const TrainOptions& opt, const GlobalOptions& global) {
   printNearSymmetries(bank);
   if (!global.quiet) {
     if (timings.dropped) fmt::print("dropped: {} views with too few features\n", timings.dropped);
+    if (const std::size_t colour_only = colourOnlyTemplates(bank))
+      fmt::print("colour only: {} templates whose views' depth shows too little of the part (thin, seen edge on)\n",
+                 colour_only);
     fmt::print("time: {:.1f} s (render {:.1f} s, features {:.1f} s) on {}, {:.0f} templates/s\n",
                timings.total_ms / 1e3, timings.render_ms / 1e3, timings.features_ms / 1e3, ctx.device().name,
                1e3 * static_cast<double>(bank.templates.size()) / timings.total_ms);
@@ -132,9 +153,13 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
                   "up: views about the up axis only (objects standing upright); all: also a hemisphere about each "
                   "other pose the object rests in (lying on a side, upside down) that no near-symmetry covers, for "
                   "objects tipped over or in bins: up to 6x the templates and the matching time; auto: all for a "
-                  "part smaller than 10 cm across (small parts lie any way up in bins), up otherwise")
+                  "part smaller than 10 cm across or trained nearer than 0.5 m (parts in bins lie any way up), up "
+                  "otherwise")
       ->check(CLI::IsMember({"auto", "all", "up"}))
       ->capture_default_str();
+  sub->add_flag("--allow-small", opt->allow_small,
+               "Train a part too small to tell from its neighbourhood where it is trained (under 2 cells of "
+               "LINEMOD's coarsest level across at the nearest --radii), which train refuses otherwise");
   sub->add_option("--max-view-angle", opt->max_view_angle,
                   "Keep only viewpoints within this angle of the object's up axis, degrees (e.g. 40 for parts that stand "
                   "upright under a camera looking down)")

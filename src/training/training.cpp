@@ -227,12 +227,20 @@ ExtractedTemplate selectFeatures(const QuantizedView& q, const cv::Mat& crop_mas
       chosen[1][l] = selectScattered(depthCandidates(q.depth[l], mask), params.features_per_modality);
   }
   ExtractedTemplate out;
+  // A view whose depth shows too little of the object keeps its colour features alone when
+  // they suffice: a screw's shank 3-5 pixels wide has no surface normals at the coarse level
+  // (every view of a thin screw was dropped), but its outline has gradients all along.
+  bool depth_starved = false;
+  for (std::size_t l = 0; l < levels; ++l)
+    depth_starved |= fp.use_colour && fp.use_depth && chosen[1][l].size() < 4 && chosen[0][l].size() >= 4;
+  if (depth_starved)
+    for (auto& level : chosen[1]) level.clear();
   // The template's box over all levels and modalities, in level-0 pixels (even origin, so
   // every level's origin is a whole pixel), as OpenCV's cropTemplates.
   int min_x = INT32_MAX, min_y = INT32_MAX, max_x = INT32_MIN, max_y = INT32_MIN;
   for (int m = 0; m < kModalityCount; ++m)
     for (std::size_t l = 0; l < levels; ++l) {
-      const bool on = m == 0 ? fp.use_colour : fp.use_depth;
+      const bool on = m == 0 ? fp.use_colour : fp.use_depth && !depth_starved;
       if (on && chosen[m][l].size() < 4) return out;  // too little of the object to match
       for (const auto& c : chosen[m][l]) {
         min_x = std::min(min_x, c.x << l);

@@ -25,6 +25,60 @@ void validateTrainingParams(const TrainingParams& p) {
     throw InputError(fmt::format("strong threshold {} must be in (0, 2000)", p.strong_threshold));
 }
 
+namespace {
+/// Pixels per cell of LINEMOD's coarsest level (2^(levels - 1) * T), 0 without levels.
+double coarseCellPixels(const TrainingParams& params) {
+  const std::vector<int>& T = params.features.T;
+  return T.empty() ? 0.0 : static_cast<double>(1 << (T.size() - 1)) * T.back();
+}
+}  // namespace
+
+PartSizeEvidence partSizeEvidence(const Mesh& mesh, const TrainingParams& params) {
+  PartSizeEvidence e;
+  e.diameter_m = mesh.diameter;
+  e.thinnest_m = (mesh.bbox_max - mesh.bbox_min).minCoeff();
+  e.nearest_m = std::min(params.views.radii.from, params.views.radii.to);
+  e.farthest_m = std::max(params.views.radii.from, params.views.radii.to);
+  const float f = 0.5f * static_cast<float>(params.camera.fx + params.camera.fy);
+  const float cell = static_cast<float>(coarseCellPixels(params));
+  if (!(f > 0.f && e.nearest_m > 0.f)) return e;
+  e.pixels_near = f * e.diameter_m / e.nearest_m;
+  e.pixels_far = f * e.diameter_m / e.farthest_m;
+  e.thin_pixels_far = f * e.thinnest_m / e.farthest_m;
+  e.cells_near = cell > 0.f ? e.pixels_near / cell : 0.f;
+  e.cells_far = cell > 0.f ? e.pixels_far / cell : 0.f;
+  e.pixel_mm_near = 1e3f * e.nearest_m / f;
+  e.pixel_mm_far = 1e3f * e.farthest_m / f;
+  return e;
+}
+
+std::string PartSizeEvidence::summary() const {
+  // "a-b" from the farthest distance's figure to the nearest's, one figure where they are one.
+  const auto span = [](float far, float near, int decimals) {
+    const std::string a = fmt::format("{:.{}f}", far, decimals), b = fmt::format("{:.{}f}", near, decimals);
+    return a == b ? a : a + "-" + b;
+  };
+  std::string s = fmt::format(
+      "{:.0f} mm across is {} pixels at {} m ({} cells of LINEMOD's coarsest level); a pixel spans {} mm there",
+      1e3f * diameter_m, span(pixels_far, pixels_near, 0), span(farthest_m, nearest_m, 2),
+      span(cells_far, cells_near, 1), span(pixel_mm_far, pixel_mm_near, 2));
+  if (thin_in_depth())
+    s += fmt::format(
+        ". Its thinnest side, {:.1f} mm, is {:.1f} pixels at {:.2f} m: a structured-light or stereo sensor's "
+        "matching window (7-9 pixels) merges it into what lies behind, so its depth shows little of it",
+        1e3f * thinnest_m, thin_pixels_far, farthest_m);
+  return s;
+}
+
+std::string PartSizeEvidence::refusal() const {
+  return fmt::format(
+      "{:.0f} mm across at {:.2f} m is {:.0f} pixels, {:.1f} cells of LINEMOD's coarsest level, under the {:.0f} "
+      "a part needs to be told from its neighbourhood: its few features fit any screw head or part end, and a "
+      "bank of it finds them everywhere. Train (and detect) nearer, with a longer focal length, or pass "
+      "--allow-small to train it anyway",
+      1e3f * diameter_m, nearest_m, pixels_near, cells_near, kMinPartCells);
+}
+
 std::vector<std::string> trainingWarnings(const Mesh& mesh, const TrainingParams& params) {
   std::vector<std::string> warnings;
   // LINEMOD's coarsest level sees the object at 1 / 2^(levels - 1) of the resolution, in

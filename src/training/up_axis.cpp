@@ -183,17 +183,18 @@ std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const E
   return out;
 }
 
-bool trainsOtherRestingPoses(const std::string& resting, float diameter_m) {
+bool trainsOtherRestingPoses(const std::string& resting, float diameter_m, float nearest_distance_m) {
   if (resting == "all") return true;
   if (resting == "up") return false;
-  if (resting == "auto") return isSmallPart(diameter_m);
+  if (resting == "auto") return isSmallPart(diameter_m) || nearest_distance_m < kPileDistanceM;
   throw InputError(fmt::format("resting: '{}' is none of auto, all, up", resting));
 }
 
 TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up, const std::string& resting,
                           float max_view_angle_deg) {
   TrainingPlan plan;
-  const bool trains_others = trainsOtherRestingPoses(resting, mesh.diameter);  // throws first on a bad name
+  const bool trains_others =  // throws first on a bad name
+      trainsOtherRestingPoses(resting, mesh.diameter, std::min(params.views.radii.from, params.views.radii.to));
   plan.found = findUpAxis(mesh);
   if (auto_up) params.views.up = plan.found.up;
   params.views.other_ups.clear();

@@ -53,15 +53,25 @@ if ! "$vkpose" -q train "$dir/cube.obj" --units m --views 2 --radii 0.6 --inplan
   cat "$dir/train.log"
   exit 1
 fi
-# A part too small for LINEMOD's coarse level at its distance: a warning says so before the
-# training (which may then find too few features in every view: either exit is fine here).
+# A part too small for LINEMOD's coarse level at its distance (16 pixels, 1 cell): refused with
+# exit 1 and what to do, no bank written; with --allow-small a warning says so before the
+# training (which may then find too few features in every view: either exit is fine there).
 "$vkpose" -q train "$dir/cube.obj" --units m --views 2 --radii 3 --inplane 0 --out "$dir/far.vkpb" >"$dir/far.log" 2>&1
-if ! grep -q "cells of LINEMOD's coarsest level" "$dir/far.log"; then
-  echo "FAIL train: a part 16 pixels across warns:"
+rc=$?
+if [ $rc -ne 1 ] || [ -e "$dir/far.vkpb" ] || ! grep -q "allow-small" "$dir/far.log"; then
+  echo "FAIL train: a part 16 pixels across is refused (exit $rc):"
   cat "$dir/far.log"
   failed=1
 else
-  echo "ok   train: too small to match well: $(grep warning "$dir/far.log")"
+  echo "ok   train: too small is refused: $(head -c 160 "$dir/far.log")"
+fi
+"$vkpose" -q train "$dir/cube.obj" --units m --views 2 --radii 3 --inplane 0 --allow-small --out "$dir/far.vkpb" >"$dir/far.log" 2>&1
+if ! grep -q "cells of LINEMOD's coarsest level" "$dir/far.log"; then
+  echo "FAIL train: a part 16 pixels across, allowed, warns:"
+  cat "$dir/far.log"
+  failed=1
+else
+  echo "ok   train: allowed, too small to match well: $(grep warning "$dir/far.log")"
 fi
 if grep -q "cells of LINEMOD" "$dir/train.log"; then
   echo "FAIL train: the cube at 0.6 m (82 pixels) warns:"

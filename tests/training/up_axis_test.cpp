@@ -147,15 +147,44 @@ TEST(UpAxis, OtherRestingPosesAreTheSidesItLiesOnThatNoNearSymmetryCovers) {
   }
 }
 
-// --resting auto (train's default): a part smaller than 10 cm lies any way up in a bin, so
-// training covers its other resting poses; a larger object is trained standing.
-TEST(UpAxis, RestingAutoTrainsEveryPoseOfASmallPartOnly) {
-  EXPECT_TRUE(trainsOtherRestingPoses("auto", 0.04f));
-  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.1f));
-  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.25f));
-  EXPECT_TRUE(trainsOtherRestingPoses("all", 0.25f));
-  EXPECT_FALSE(trainsOtherRestingPoses("up", 0.04f));
-  EXPECT_THROW(trainsOtherRestingPoses("sideways", 0.04f), InputError);
+// --resting auto (train's default): a part smaller than 10 cm lies any way up in a bin, and so
+// does any part trained nearer than 0.5 m (a bin-picking cell's distance), so training covers
+// its other resting poses; a larger object seen from farther is trained standing.
+TEST(UpAxis, RestingAutoTrainsEveryPoseOfASmallPartOrOneTrainedForABin) {
+  EXPECT_TRUE(trainsOtherRestingPoses("auto", 0.04f, 0.6f));
+  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.1f, 0.6f));
+  EXPECT_FALSE(trainsOtherRestingPoses("auto", 0.25f, 0.5f));
+  EXPECT_TRUE(trainsOtherRestingPoses("auto", 0.17f, 0.3f));
+  EXPECT_TRUE(trainsOtherRestingPoses("auto", 0.25f, 0.49f));
+  EXPECT_TRUE(trainsOtherRestingPoses("all", 0.25f, 0.6f));
+  EXPECT_FALSE(trainsOtherRestingPoses("up", 0.04f, 0.3f));
+  EXPECT_THROW(trainsOtherRestingPoses("sideways", 0.04f, 0.6f), InputError);
+}
+
+// The size evidence `vkpose train` prints and refuses on: with LINEMOD's Kinect (f about 572
+// px) and its two levels of T 4 and 8 (16 pixels a coarse cell), a nut 12 mm across at 0.3-0.5 m
+// spans 14-24 pixels, 0.9-1.5 cells: too small to tell from a screw head. A 40 mm bracket at
+// 0.3-0.45 m (3.7-5.5 cells) is not, and a screw 3 mm thick at 0.45 m is 3.8 pixels: thin in depth.
+TEST(UpAxis, SizeEvidenceRefusesAPartTooSmallToTellFromItsNeighbourhood) {
+  TrainingParams params;
+  params.views.radii = {0.3f, 0.5f, 0.05f};
+  const PartSizeEvidence nut = partSizeEvidence(test::boxMesh({0.008f, 0.008f, 0.005f}), params);
+  EXPECT_NEAR(nut.pixels_near, 572.f * nut.diameter_m / 0.3f, 2.f);
+  EXPECT_NEAR(nut.cells_near, nut.pixels_near / 16.f, 1e-3f);
+  EXPECT_TRUE(nut.too_small()) << nut.summary();
+  EXPECT_NE(nut.refusal().find("--allow-small"), std::string::npos);
+  EXPECT_NE(nut.summary().find("0.50-0.30 m"), std::string::npos) << nut.summary();
+
+  params.views.radii = {0.3f, 0.45f, 0.05f};
+  const PartSizeEvidence bracket = partSizeEvidence(test::boxMesh({0.04f, 0.02f, 0.012f}), params);
+  EXPECT_FALSE(bracket.too_small()) << bracket.summary();
+  EXPECT_GT(bracket.cells_far, 2.5f);
+  EXPECT_FALSE(bracket.thin_in_depth()) << bracket.summary();
+
+  const PartSizeEvidence screw = partSizeEvidence(test::boxMesh({0.003f, 0.003f, 0.05f}), params);
+  EXPECT_FALSE(screw.too_small()) << screw.summary();
+  EXPECT_TRUE(screw.thin_in_depth());
+  EXPECT_NE(screw.summary().find("thinnest side, 3.0 mm"), std::string::npos) << screw.summary();
 }
 
 // planTraining: what `vkpose train` and vkpose.train() decide before rendering. A brick 4 cm
