@@ -341,7 +341,9 @@ void validateSensorParams(const SensorParams& params);
 
 /// A named sensor profile (`--sensor`): "kinect" (the default, structured light: 1.5 mm at
 /// 1 m, a 1 mm step), "primesense" (Carmine-class short range: 1.0 mm at 1 m), "realsense-d435"
-/// (active stereo: 2.5 mm at 1 m) or "ideal" (no noise, no step); or the path of a JSON file
+/// (active stereo: 2.5 mm at 1 m), "close-range" (a D415-class stereo camera over a bin at
+/// 0.3-0.5 m: 2.0 mm at 1 m; synth also renders its edges, thin parts and specular holes) or
+/// "ideal" (no noise, no step); or the path of a JSON file
 /// {"axial_sigma_at_1m": metres, "quantization_m": metres}. InputError for an unknown name or
 /// a bad file.
 SensorParams sensorProfile(const std::string& name_or_file);

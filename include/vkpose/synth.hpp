@@ -6,6 +6,7 @@
 // the whole pipeline on three objects built in code, piled in synthetic bins.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,6 +42,19 @@ struct DepthNoiseParams {
   int holes = 0;                      ///< random elliptic holes per frame (0: off)
   float hole_radius_px[2] = {3.f, 12.f};  ///< smallest and largest hole semi-axis, pixels
   float max_range_m = 0.f;            ///< readings farther than this are lost (0: no limit)
+  /// A stereo or structured-light camera correlates a window of this many pixels a side: its
+  /// depth at a pixel is the window's median surface (0 or 1: off). Corners come out rounded,
+  /// depth edges ragged, and anything thinner than about half the window (a screw's shank, a
+  /// wire) merges into what lies behind it.
+  int matching_window_px = 0;
+  /// Bare metal mirrors the projector's pattern away from the camera, or back into it so
+  /// brightly that it saturates: where a metal surface faces the camera within this angle (the
+  /// projector sits beside the lens), the chance of no reading is specular_dropout.
+  float specular_lobe_deg = 20.f;
+  float specular_dropout = 0.f;       ///< on metal only (SceneRendering::metal); 0: off
+  /// Scattered dropouts all over metal (the pattern's dots lost on shiny, curved surfaces), in
+  /// blobs of 2-4 pixels: this share of a metal surface reads nothing.
+  float metal_dropout = 0.f;
 };
 
 enum class Layout { Table, Bin };
@@ -85,6 +99,14 @@ DepthNoiseParams synthNoise();
 /// The same with a sensor profile's axial noise and depth step (config.hpp's sensorProfile());
 /// a noiseless profile ("ideal") also reads every pixel: no dropout at edges or grazing angles, no holes.
 DepthNoiseParams synthNoise(const SensorParams& sensor);
+/// `synth --sensor NAME`: synthNoise(sensorProfile(NAME)), and for "close-range" the rest of
+/// closeRangeNoise().
+DepthNoiseParams synthNoise(const std::string& sensor_name_or_file);
+/// A D415-class active stereo camera over a bin at 0.3-0.5 m (`--sensor close-range`;
+/// docs/evaluation.md says what each effect is based on): the profile's 2 mm at 1 m and 1 mm
+/// step, a 9-pixel matching window (thin parts and corners lost), half of the depth-edge pixels
+/// lost, holes where metal faces the camera and 15 % scattered dropouts on metal.
+DepthNoiseParams closeRangeNoise();
 
 struct SynthParams {
   std::vector<std::string> meshes;          ///< obj_id = 1 + index
@@ -102,7 +124,35 @@ struct SynthParams {
   /// from its nearest distance (fitBinToParts); off: placement's sizes as they are.
   bool fit_bin_to_parts = true;
   CameraRange camera_range;                 ///< random: where the camera may be
+  /// The parts (not the clutter, bin or table) are bare metal: grey, dim in diffuse light,
+  /// with bright highlights from the light and from a lamp beside the lens, and, with a
+  /// sensor that has them (closeRangeNoise), specular holes in their depth.
+  bool metal_parts = false;
+  /// A monochrome camera: the colour image's three channels are the same grey.
+  bool greyscale = false;
+  /// Random: per image, this many copies of the parts (a random mesh each) scaled by 0.8-0.9 or
+  /// 1.1-1.2, placed among them and not in the ground truth: the next screw size, a smaller cup,
+  /// look-alikes a detector must not report as the part. SCENE/scaled/IMAGE.json says where
+  /// (loadScaledCopies); `vkpose eval` counts those reported.
+  int scaled_copies = 0;
 };
+
+/// A copy of a part at another scale (SynthParams::scaled_copies): the mesh of `obj_id` scaled
+/// about its own origin by `scale`, at `pose` (object-to-camera).
+struct ScaledCopy {
+  int obj_id = 0;
+  float scale = 1.f;
+  Pose pose;
+};
+/// The scaled copies synth wrote for an image of its dataset (SCENE/scaled/IMAGE.json), none
+/// when it wrote none. InputError for a file that is not one.
+std::vector<ScaledCopy> loadScaledCopies(const BopImage& image);
+/// Of `copies`, how many a detection reports as the part: a detection of the copy's object
+/// (banks_by_obj_id: obj_id -> index of its bank in `banks`) with a score of `min_score` or
+/// more whose model centre lies within a quarter of the diameter of the copy's.
+int scaledCopiesReported(const std::vector<ScaledCopy>& copies, const std::vector<Detection>& detections,
+                         const std::vector<TemplateBank>& banks, const std::map<int, int>& banks_by_obj_id,
+                         float min_score);
 
 /// InputError for parameters no dataset can come from (no mesh, images < 1, instances or
 /// clutter out of range, a --symmetric obj_id without a mesh, poses neither "random" nor a
@@ -232,5 +282,12 @@ std::vector<Mesh> demoMeshes();
 /// and assets/meshes/ hold them; returns the paths. InputError when a file exists and
 /// `overwrite` is false.
 std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite);
+
+/// Four small bare-metal parts of a pile, built in code, metres, steel grey: an M6 hex nut
+/// (12.5 mm across), an M3 cap screw 48 mm long, a 58 mm nozzle and a 170 mm spark-plug key.
+/// What issue 51's real frames held, for synthetic piles (`synth --sensor close-range --metal`).
+std::vector<Mesh> partMeshes();
+/// Writes partMeshes() into `dir` as writeDemoMeshes does (assets/parts/ holds them).
+std::vector<std::string> writePartMeshes(const std::string& dir, bool overwrite);
 
 }  // namespace vkpose

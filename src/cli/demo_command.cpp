@@ -22,7 +22,7 @@ using util::ProgressBar;
 namespace {
 struct DemoOptions {
   DemoParams params;
-  std::string cache = defaultBankCacheDir(), config, write_meshes;
+  std::string cache = defaultBankCacheDir(), config, write_meshes, write_parts;
   bool no_cache = false;
   bool pick = false;
 };
@@ -98,9 +98,16 @@ Runner addDemoCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--write-meshes", opt->write_meshes,
                   "Only write the three objects as PLY (millimetres) into this folder and stop (assets/meshes is "
                   "made so); --force replaces files there");
+  sub->add_option("--write-parts", opt->write_parts,
+                  "Only write four small metal parts (a hex nut, a cap screw, a nozzle, a spark-plug key) as PLY "
+                  "(millimetres) into this folder and stop (assets/parts is made so), for synth's piles; --force "
+                  "replaces files there")
+      ->excludes("--write-meshes");
   return [opt, &global]() {
-    if (!opt->write_meshes.empty()) {
-      for (const std::string& path : writeDemoMeshes(opt->write_meshes, opt->params.overwrite))
+    if (!opt->write_meshes.empty() || !opt->write_parts.empty()) {
+      const bool parts = !opt->write_parts.empty();
+      for (const std::string& path : parts ? writePartMeshes(opt->write_parts, opt->params.overwrite)
+                                           : writeDemoMeshes(opt->write_meshes, opt->params.overwrite))
         if (!global.quiet) fmt::print("wrote {}\n", path);
       return 0;
     }

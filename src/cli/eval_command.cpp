@@ -69,6 +69,27 @@ std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)
   };
 }
 
+/// Scaled copies of the parts (synth --scaled-copies) that a detection reported as the part.
+struct CopyCheck {
+  int copies = 0, reported = 0;
+};
+
+/// An on_detections callback that counts the scaled copies of each image (SCENE/scaled/IMAGE.json
+/// when synth wrote one) reported as the part at score 0.5 or more, then calls `next`.
+std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> copyChecker(
+    const std::map<int, TemplateBank>& banks, CopyCheck& check,
+    std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> next) {
+  auto bank_list = std::make_shared<std::vector<TemplateBank>>();
+  auto index = std::make_shared<std::map<int, int>>();  // obj_id -> bank index (obj_id order)
+  for (const auto& [obj_id, bank] : banks) (*index)[obj_id] = static_cast<int>(bank_list->size()), bank_list->push_back(bank);
+  return [bank_list, index, &check, next](const BopImage& im, const LinemodFrame& frame, const DetectionResult& result) {
+    const std::vector<ScaledCopy> copies = loadScaledCopies(im);
+    check.copies += static_cast<int>(copies.size());
+    check.reported += scaledCopiesReported(copies, result.detections, *bank_list, *index, 0.5f);
+    if (next) next(im, frame, result);
+  };
+}
+
 /// "OBJ_ID=BANK" pairs -> obj_id -> bank path.
 std::map<int, std::string> parseBankArgs(const std::vector<std::string>& args) {
   std::map<int, std::string> out;
@@ -127,7 +148,8 @@ void printPrSummary(const EvalReport& report) {
 }
 
 /// The report of the run: on this process, or spread over Dask's workers.
-EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const EvalRunParams& params, PickCheck& picks) {
+EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const EvalRunParams& params, PickCheck& picks,
+                    CopyCheck& copies) {
   const BopDataset dataset = loadBopDataset(opt.dataset, opt.split);
   const std::map<int, std::string> bank_paths = parseBankArgs(opt.banks);
   if (opt.dask.workers > 0 || !opt.dask.scheduler.empty()) {
@@ -150,6 +172,7 @@ EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const E
   checkBanksAgainstDataset(banks, dataset);
   EvalRunParams run = params;
   if (!opt.grasps.empty()) run.on_detections = pickChecker(opt, banks, picks);
+  run.on_detections = copyChecker(banks, copies, run.on_detections);
   GpuContext ctx(global.gpu());
   ProgressBar bar("evaluating", global.quiet);
   EvalReport report =
@@ -176,7 +199,8 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
     throw InputError(opt.dataset + ": no such dataset folder");
 
   PickCheck picks;
-  const EvalReport report = evaluate(opt, global, params, picks);
+  CopyCheck copies;
+  const EvalReport report = evaluate(opt, global, params, picks, copies);
   for (const auto& w : report.warnings) fmt::print(stderr, "vkpose: warning: {}\n", w);
 
   const std::string criterion = params.eval.error == PoseErrorType::Proj2D
@@ -191,12 +215,17 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
                picks.frames, picks.frames > 0 ? 100.0 * picks.ok / picks.frames : 0.0);
     for (const std::string& p : picks.problems) fmt::print("  {}\n", p);
   }
+  if (copies.copies > 0)
+    fmt::print("scaled copies (0.8-0.9x, 1.1-1.2x) reported as the part at score >= 0.5: {} of {} ({:.1f} %)\n",
+               copies.reported, copies.copies, 100.0 * copies.reported / copies.copies);
   if (!opt.report.empty()) {
     std::string json = evalReportJson(report);
-    if (!opt.grasps.empty()) {
+    if (!opt.grasps.empty() || copies.copies > 0) {
       nlohmann::json doc = nlohmann::json::parse(json);
-      doc["picks"] = {{"order", opt.pick_order}, {"images", picks.frames}, {"first_pick_ok", picks.ok},
-                      {"problems", picks.problems}};
+      if (!opt.grasps.empty())
+        doc["picks"] = {{"order", opt.pick_order}, {"images", picks.frames}, {"first_pick_ok", picks.ok},
+                        {"problems", picks.problems}};
+      if (copies.copies > 0) doc["scaled_copies"] = {{"copies", copies.copies}, {"reported", copies.reported}};
       json = doc.dump(2) + "\n";
     }
     writeTextFile(opt.report, json, opt.force);

@@ -100,7 +100,18 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--symmetric", p.symmetric,
                   "obj_id of a mesh with a continuous symmetry about its z axis (models_info.json's "
                   "symmetries_continuous, so ADI scores it); repeat for several");
-  addSensorOption(sub, opt->sensor, "the depth noise and step the images are rendered with");
+  addSensorOption(sub, opt->sensor,
+                  "the depth noise and step the images are rendered with; close-range also renders a stereo "
+                  "camera's 9-pixel matching window (rounded edges, thin parts lost) and holes on metal");
+  sub->add_flag("--metal", p.metal_parts,
+                "The parts are bare metal: grey, with highlights from the light and from a lamp beside the lens, and "
+                "with --sensor close-range, holes in their depth where they face the camera");
+  sub->add_option("--scaled-copies", p.scaled_copies,
+                  "random: per image, copies of the parts scaled by 0.8-0.9 or 1.1-1.2 placed among them, not in "
+                  "the ground truth (test/000001/scaled/IMAGE.json): look-alikes vkpose eval counts when reported "
+                  "as the part")
+      ->capture_default_str();
+  sub->add_flag("--grey", p.greyscale, "A monochrome camera: the colour image's three channels are the same grey");
   sub->add_flag("--force", opt->force,
                 "Write into a non-empty --out: removes its models/, test/000001/ and camera.json first");
   return [opt, &global]() {
@@ -109,7 +120,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     params.placement.layout = opt->layout == "bin" ? Layout::Bin : Layout::Table;
     std::tie(params.min_instances, params.max_instances) = parseRange(opt->instances);
     if (!opt->camera.empty()) params.camera = loadCamera(opt->camera);
-    if (!opt->sensor.empty()) params.noise = synthNoise(sensorProfile(opt->sensor));
+    if (!opt->sensor.empty()) params.noise = synthNoise(opt->sensor);
     if (!opt->camera_distance.empty()) {
       const auto d = parseMetres(opt->camera_distance, "--camera-distance", 2, 2);
       params.camera_range.min_distance_m = d[0];

@@ -43,11 +43,14 @@ struct NamedSensor {
 };
 // Axial noise at 1 m from the sensors' depth models (Khoshelham and Elberink 2012 for the
 // Kinect; the RealSense D435's is z^2 * subpixel / (focal * baseline) at 0.08 px, 640 px,
-// 50 mm); every one writes millimetre depth images.
+// 50 mm; the close-range D415-class stereo camera's at 0.08 px, 720 px, 55 mm); every one
+// writes millimetre depth images. synth adds the close-range camera's other effects
+// (closeRangeNoise, synth.hpp).
 constexpr NamedSensor kSensors[] = {
     {"kinect", {0.0015f, 0.001f}},
     {"primesense", {0.0010f, 0.001f}},
     {"realsense-d435", {0.0025f, 0.001f}},
+    {"close-range", {0.0020f, 0.001f}},
     {"ideal", {0.f, 0.f}},
 };
 }  // namespace

@@ -87,14 +87,24 @@ void validateDemoParams(const DemoParams& params) {
   validateDetectorParams(params.detector);
 }
 
-std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite) {
+namespace {
+std::vector<std::string> writeMeshes(const std::vector<Mesh>& meshes, const std::string& dir, bool overwrite) {
   fs::create_directories(dir);
   std::vector<std::string> paths;
-  for (const Mesh& mesh : demoMeshes()) {
+  for (const Mesh& mesh : meshes) {
     paths.push_back((fs::path(dir) / (mesh.name + ".ply")).string());
     writePlyMillimetres(mesh, paths.back(), overwrite);
   }
   return paths;
+}
+}  // namespace
+
+std::vector<std::string> writeDemoMeshes(const std::string& dir, bool overwrite) {
+  return writeMeshes(demoMeshes(), dir, overwrite);
+}
+
+std::vector<std::string> writePartMeshes(const std::string& dir, bool overwrite) {
+  return writeMeshes(partMeshes(), dir, overwrite);
 }
 
 namespace {

@@ -185,4 +185,69 @@ Mesh angleBracketMesh() {
 
 std::vector<Mesh> demoMeshes() { return {liddedCupMesh(), gableCartonMesh(), angleBracketMesh()}; }
 
+namespace {
+const Eigen::Vector3f kSteel(0.62f, 0.63f, 0.66f);
+/// A (radius, z) profile in millimetres, as lathe takes it in metres.
+std::vector<Eigen::Vector2f> millimetres(std::vector<Eigen::Vector2f> profile) {
+  for (auto& p : profile) p *= 1e-3f;
+  return profile;
+}
+}  // namespace
+
+Mesh hexNutMesh() {
+  // Six trapezoids between the outer hexagon and the bore's, each a convex prism.
+  const float outer = 0.005f / std::cos(std::numbers::pi_v<float> / 6.f), bore = 0.0032f, height = 0.005f;
+  const auto corner = [](float radius, int k) {
+    const float a = std::numbers::pi_v<float> / 3.f * static_cast<float>(k);
+    return Eigen::Vector2f(radius * std::cos(a), radius * std::sin(a));
+  };
+  Mesh nut;
+  for (int k = 0; k < 6; ++k)
+    append(nut, procedural::prism({corner(outer, k), corner(outer, k + 1), corner(bore, k + 1), corner(bore, k)}, height, kSteel),
+           Eigen::Matrix3f::Identity(), {0.f, 0.f, 0.5f * height});
+  nut.name = "hex_nut";
+  finishMesh(nut);
+  return nut;
+}
+
+Mesh capScrewMesh() {
+  Mesh screw = procedural::lathe(
+      millimetres({{0.f, 0.f}, {2.75f, 0.f}, {2.75f, 3.f}, {1.5f, 3.f}, {1.5f, 47.6f}, {1.1f, 48.f}, {0.f, 48.f}}), 24,
+      kSteel);
+  screw.name = "cap_screw";
+  finishMesh(screw);
+  return screw;
+}
+
+Mesh nozzleMesh() {
+  Mesh nozzle = procedural::lathe(millimetres({{0.f, 0.f},
+                                               {7.f, 0.f},
+                                               {7.f, 8.f},
+                                               {10.f, 8.f},
+                                               {10.f, 12.f},
+                                               {6.5f, 12.f},
+                                               {6.5f, 45.f},
+                                               {3.f, 58.f},
+                                               {0.f, 58.f}}),
+                                  32, kSteel);
+  nozzle.name = "nozzle";
+  finishMesh(nozzle);
+  return nozzle;
+}
+
+Mesh sparkPlugKeyMesh() {
+  Mesh key = procedural::lathe(millimetres({{0.f, 0.f}, {11.f, 0.f}, {11.f, 70.f}, {8.f, 75.f}, {8.f, 95.f}, {0.f, 95.f}}),
+                               32, kSteel);
+  // The T-bar: a rod along x through the top of the neck.
+  Eigen::Matrix3f along_x;  // lathe axis z -> world x
+  along_x << 0, 0, 1, 0, 1, 0, -1, 0, 0;
+  append(key, procedural::lathe(millimetres({{0.f, -85.f}, {5.f, -85.f}, {5.f, 85.f}, {0.f, 85.f}}), 24, kSteel),
+         along_x, {0.f, 0.f, 0.088f});
+  key.name = "spark_plug_key";
+  finishMesh(key);
+  return key;
+}
+
+std::vector<Mesh> partMeshes() { return {hexNutMesh(), capScrewMesh(), nozzleMesh(), sparkPlugKeyMesh()}; }
+
 }  // namespace vkpose

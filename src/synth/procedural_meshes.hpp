@@ -22,6 +22,18 @@ Mesh gableCartonMesh();
 /// (10 x 6 x 7 cm).
 Mesh angleBracketMesh();
 
+/// Small bare-metal parts of a pile, as issue 51's real frames held (`vkpose demo
+/// --write-parts`, assets/parts/): +z up as each stands, base at z = 0, steel grey.
+/// An M6 hex nut: 10 mm across the flats, 5 mm high, a hexagonal bore (12.5 mm across).
+Mesh hexNutMesh();
+/// A long thin screw: an M3 shank 45 mm long under a 5.5 mm cap head (48 mm long).
+Mesh capScrewMesh();
+/// A nozzle: a 14 mm spigot, a 20 mm collar, a 13 mm body and a conical tip (58 mm long).
+Mesh nozzleMesh();
+/// A spark-plug key: a 22 mm socket tube 95 mm long with a 170 mm T-bar through its top
+/// (170 mm across).
+Mesh sparkPlugKeyMesh();
+
 /// Building blocks, exposed for tests.
 namespace procedural {
 

@@ -1,8 +1,10 @@
 // Synthetic multi-object scenes and sensor noise.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -197,26 +199,97 @@ Mesh cylinderMesh(float radius, float height, const Eigen::Vector3f& rgb, int se
   return m;
 }
 
+MetalLighting metalLighting(const Lighting& light) {
+  MetalLighting m;
+  m.light = light;
+  m.light.ambient = 0.6f * light.ambient;
+  m.light.diffuse = 0.4f * light.diffuse;
+  m.light.specular = 0.6f + light.specular;
+  m.light.shininess = 2.f * light.shininess;
+  return m;
+}
+
+void markMetal(SceneRendering& scene, std::size_t first, std::size_t last) {
+  if (scene.metal.empty()) scene.metal = cv::Mat::zeros(scene.instance.size(), CV_8UC1);
+  for (int y = 0; y < scene.instance.rows; ++y)
+    for (int x = 0; x < scene.instance.cols; ++x) {
+      const std::size_t label = scene.instance.at<uint16_t>(y, x);
+      if (label > first && label <= last) scene.metal.at<uint8_t>(y, x) = 255;
+    }
+}
+
 void applyLighting(SceneRendering& scene, const Lighting& light) {
   if (scene.normals.size() != scene.bgr.size()) throw InputError("applyLighting: the scene has no normals");
+  const bool any_metal = scene.metal.size() == scene.bgr.size();
+  const MetalLighting metal = metalLighting(light);
   const Eigen::Vector3f to_light = -light.direction.normalized();
   const Camera& cam = scene.camera;
   for (int y = 0; y < scene.bgr.rows; ++y)
     for (int x = 0; x < scene.bgr.cols; ++x) {
       if (scene.depth.at<float>(y, x) <= 0.f) continue;
+      const bool is_metal = any_metal && scene.metal.at<uint8_t>(y, x) != 0;
+      const Lighting& l = is_metal ? metal.light : light;
       const cv::Vec3f& nv = scene.normals.at<cv::Vec3f>(y, x);
       const Eigen::Vector3f n(nv[0], nv[1], nv[2]);
       const float lambert = std::max(0.f, n.dot(to_light));
       // Phong: the light mirrored about the normal against the direction to the camera.
-      const Eigen::Vector3f to_eye =
-          -cam.ray(x, y).normalized();
+      const Eigen::Vector3f to_eye = -cam.ray(x, y).normalized();
       const Eigen::Vector3f mirrored = 2.f * n.dot(to_light) * n - to_light;
-      const float highlight =
-          lambert > 0.f ? light.specular * 255.f * std::pow(std::max(0.f, mirrored.dot(to_eye)), light.shininess) : 0.f;
+      float highlight =
+          lambert > 0.f ? l.specular * 255.f * std::pow(std::max(0.f, mirrored.dot(to_eye)), l.shininess) : 0.f;
       cv::Vec3b& c = scene.bgr.at<cv::Vec3b>(y, x);
+      if (is_metal) {
+        // Grey metal; the lamp beside the lens mirrors back from whatever faces the camera.
+        highlight += metal.headlight * 255.f * std::pow(std::max(0.f, n.dot(to_eye)), metal.headlight_shininess);
+        const float grey = 0.114f * c[0] + 0.587f * c[1] + 0.299f * c[2];
+        c = cv::Vec3b::all(cv::saturate_cast<uint8_t>(grey));
+      }
       for (int k = 0; k < 3; ++k)
-        c[k] = cv::saturate_cast<uint8_t>(c[k] * light.gain[k] * (light.ambient + light.diffuse * lambert) + highlight);
+        c[k] = cv::saturate_cast<uint8_t>(c[k] * l.gain[k] * (l.ambient + l.diffuse * lambert) + highlight);
     }
+}
+
+cv::Mat windowMedianDepth(const cv::Mat& depth, int window) {
+  if (window <= 1) return depth.clone();
+  const int r = window / 2;
+  // Only where the window spans a depth change (more than a millimetre) can the median differ
+  // from the centre by more than the noise; elsewhere the input stands.
+  cv::Mat lo, hi, holes_near;
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1));
+  const cv::Mat holes = depth <= 0.f;
+  cv::Mat filled = depth.clone();
+  filled.setTo(1e6f, holes);
+  cv::erode(filled, lo, kernel);
+  cv::dilate(depth, hi, kernel);
+  cv::dilate(holes, holes_near, kernel);
+  cv::Mat out = depth.clone();
+  std::vector<float> values;
+  values.reserve(static_cast<std::size_t>((2 * r + 1) * (2 * r + 1)));
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) {
+      if (!holes_near.at<uint8_t>(y, x) && hi.at<float>(y, x) - lo.at<float>(y, x) <= 1e-3f) continue;
+      values.clear();
+      int cells = 0;
+      for (int v = std::max(0, y - r); v <= std::min(depth.rows - 1, y + r); ++v)
+        for (int u = std::max(0, x - r); u <= std::min(depth.cols - 1, x + r); ++u) {
+          ++cells;
+          if (const float z = depth.at<float>(v, u); z > 0.f) values.push_back(z);
+        }
+      if (2 * values.size() <= static_cast<std::size_t>(cells)) {
+        out.at<float>(y, x) = 0.f;
+        continue;
+      }
+      const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+      std::nth_element(values.begin(), mid, values.end());
+      out.at<float>(y, x) = *mid;
+    }
+  return out;
+}
+
+void toGreyscale(LinemodFrame& frame) {
+  cv::Mat grey;
+  cv::cvtColor(frame.bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey, frame.bgr, cv::COLOR_GRAY2BGR);
 }
 
 namespace {
@@ -249,13 +322,42 @@ void dropGrazingAndHoles(const SceneRendering& scene, const DepthNoiseParams& no
     cv::ellipse(depth_mm, centre, axes, 180.0 * uniform(rng), 0, 360, cv::Scalar(0), cv::FILLED);
   }
 }
+
+/// What bare metal loses (DepthNoiseParams::specular_dropout, metal_dropout): its own random
+/// stream, as dropGrazingAndHoles'.
+void dropOnMetal(const SceneRendering& scene, const DepthNoiseParams& noise, uint32_t seed, cv::Mat& depth_mm) {
+  if (scene.metal.size() != depth_mm.size() || (noise.specular_dropout <= 0.f && noise.metal_dropout <= 0.f)) return;
+  std::mt19937 rng(seed ^ 0x6d657461u);
+  std::uniform_real_distribution<float> uniform(0.f, 1.f);
+  const float lobe = std::cos(noise.specular_lobe_deg * std::numbers::pi_v<float> / 180.f);
+  std::vector<cv::Point> metal;
+  for (int y = 0; y < depth_mm.rows; ++y)
+    for (int x = 0; x < depth_mm.cols; ++x) {
+      if (!scene.metal.at<uint8_t>(y, x)) continue;
+      metal.emplace_back(x, y);
+      const cv::Vec3f& n = scene.normals.at<cv::Vec3f>(y, x);
+      const Eigen::Vector3f ray = scene.camera.ray(x, y).normalized();
+      const float facing = std::abs(n[0] * ray.x() + n[1] * ray.y() + n[2] * ray.z());
+      if (facing > lobe && uniform(rng) < noise.specular_dropout) depth_mm.at<uint16_t>(y, x) = 0;
+    }
+  // Blobs of radius 1-2 pixels (about 7 pixels each) until metal_dropout of the metal is hit.
+  const auto blobs = static_cast<std::size_t>(noise.metal_dropout * static_cast<float>(metal.size()) / 7.f);
+  for (std::size_t b = 0; b < blobs && !metal.empty(); ++b) {
+    const cv::Point c = metal[std::min(metal.size() - 1, static_cast<std::size_t>(uniform(rng) * static_cast<float>(metal.size())))];
+    const int radius = uniform(rng) < 0.5f ? 1 : 2;
+    for (int v = std::max(0, c.y - radius); v <= std::min(depth_mm.rows - 1, c.y + radius); ++v)
+      for (int u = std::max(0, c.x - radius); u <= std::min(depth_mm.cols - 1, c.x + radius); ++u)
+        if ((u - c.x) * (u - c.x) + (v - c.y) * (v - c.y) <= radius * radius && scene.metal.at<uint8_t>(v, u))
+          depth_mm.at<uint16_t>(v, u) = 0;
+  }
+}
 }  // namespace
 
 LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& noise, uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<float> gauss(0.f, 1.f);
   std::uniform_real_distribution<float> uniform(0.f, 1.f);
-  const cv::Mat& z = scene.depth;
+  const cv::Mat z = noise.matching_window_px > 1 ? windowMedianDepth(scene.depth, noise.matching_window_px) : scene.depth;
   LinemodFrame f;
   f.depth_mm = cv::Mat::zeros(z.size(), CV_16UC1);
   for (int y = 0; y < z.rows; ++y)
@@ -281,6 +383,7 @@ LinemodFrame sensorFrame(const SceneRendering& scene, const DepthNoiseParams& no
       f.depth_mm.at<uint16_t>(y, x) = static_cast<uint16_t>(std::clamp(std::lround(noisy * 1000.f), 0l, 65535l));
     }
   dropGrazingAndHoles(scene, noise, seed, f.depth_mm);
+  dropOnMetal(scene, noise, seed, f.depth_mm);
   f.bgr = cv::Mat(scene.bgr.size(), CV_8UC3);
   for (int y = 0; y < f.bgr.rows; ++y)
     for (int x = 0; x < f.bgr.cols; ++x)

@@ -27,6 +27,8 @@ struct SceneRendering {
   std::vector<int> visible_pixels, full_pixels;
   /// CV_8UC1 silhouette of each object alone (255 inside): what it would cover unoccluded.
   std::vector<cv::Mat> full_masks;
+  /// CV_8UC1, 255 where the surface seen is bare metal (markMetal); empty: nothing is.
+  cv::Mat metal;
   float visibleFraction(std::size_t i) const {
     return full_pixels[i] > 0 ? static_cast<float>(visible_pixels[i]) / static_cast<float>(full_pixels[i]) : 0.f;
   }
@@ -62,8 +64,31 @@ struct Lighting {
 };
 
 /// Replaces scene.bgr (albedo) by albedo * gain * (ambient + diffuse * n.l) + highlight, using
-/// scene.normals; pixels where nothing is stay as they are.
+/// scene.normals; pixels where nothing is stay as they are. Where scene.metal is set,
+/// metalLighting(light) instead.
 void applyLighting(SceneRendering& scene, const Lighting& light);
+
+/// Bare metal under `light`: a grey that the diffuse light barely brightens, sharp highlights
+/// of the light, and a lamp beside the lens (a ring light, or the projector's own flash) that
+/// lights whatever faces the camera: the bright stripe along a tube, the flat of a nut.
+struct MetalLighting {
+  Lighting light;
+  float headlight = 0.9f;          ///< the lamp's highlight weight, grey levels / 255
+  float headlight_shininess = 12.f;
+};
+MetalLighting metalLighting(const Lighting& light);
+
+/// Marks objects [first, last) of the scene as bare metal in scene.metal.
+void markMetal(SceneRendering& scene, std::size_t first, std::size_t last);
+
+/// The scene's depth as a camera with a `window`-pixel correlation window measures it: each
+/// pixel the median of the surface depths within the window (holes ignored; none where most of
+/// the window is empty). Only pixels near a depth change differ from the input: the median of
+/// a plane's window is its centre.
+cv::Mat windowMedianDepth(const cv::Mat& depth, int window);
+
+/// The frame as a monochrome camera gives it: each pixel's luminance in all three channels.
+void toGreyscale(LinemodFrame& frame);
 
 /// The frame a sensor would deliver (depth in millimetres, 0 = no reading); reproducible
 /// from `seed`. Grazing dropouts use scene.normals and scene.camera.

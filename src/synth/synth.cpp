@@ -6,10 +6,12 @@
 #include <chrono>
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <optional>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "synth/placement.hpp"
@@ -95,6 +97,10 @@ struct ImageScene {
   std::deque<Mesh> owned;    ///< table, bin and clutter meshes (a deque: pointers stay valid)
   Pose camera_T_world;
   std::optional<BinBox> bin;  ///< the bin layout's bin (its frame is the world's)
+  /// Scaled copies of the parts (SynthParams::scaled_copies): the objects right after the
+  /// ground truth, in this order.
+  std::vector<ScaledCopy> copies;
+  std::size_t partsEnd() const { return obj_ids.size() + copies.size(); }
 
   void add(Mesh mesh, const Pose& world_T_object) {
     owned.push_back(std::move(mesh));
@@ -152,6 +158,48 @@ void addClutter(ImageScene& s, const SynthParams& p, const PlacementParams& plac
     if (poses[i]) s.add(std::move(meshes[i]), *poses[i]);
 }
 
+/// Copies of random parts scaled by 0.8-0.9 or 1.1-1.2, placed clear of `obstacles` (which
+/// they join), right after the ground truth.
+void addScaledCopies(ImageScene& s, const SynthParams& p, const std::vector<Mesh>& models,
+                     const PlacementParams& placement, std::vector<OrientedBox>& obstacles, std::mt19937& rng) {
+  std::vector<Mesh> meshes;
+  std::vector<ScaledCopy> copies;
+  for (int i = 0; i < p.scaled_copies; ++i) {
+    const int m = uniformInt(rng, 0, static_cast<int>(models.size()) - 1);
+    const float lo = rng() % 2 ? 1.1f : 0.8f;
+    const float scale = uniform(rng, lo, lo + 0.1f);
+    Mesh copy = models[static_cast<std::size_t>(m)];
+    for (auto& v : copy.vertices) v *= scale;
+    finishMesh(copy);
+    meshes.push_back(std::move(copy));
+    copies.push_back({m + 1, scale, {}});
+  }
+  std::vector<const Mesh*> pointers;
+  for (const auto& m : meshes) pointers.push_back(&m);
+  const auto poses = placeObjects(pointers, obstacles, placement, p.camera, s.camera_T_world, rng);
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    if (!poses[i]) continue;
+    obstacles.push_back(orientedBox(meshes[i], *poses[i]));
+    copies[i].pose = compose(s.camera_T_world, *poses[i]);
+    s.copies.push_back(copies[i]);
+    s.add(std::move(meshes[i]), *poses[i]);
+  }
+}
+
+std::string scaledCopiesJson(const std::vector<ScaledCopy>& copies) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < copies.size(); ++i) {
+    const ScaledCopy& c = copies[i];
+    const Eigen::Matrix3f& R = c.pose.R;
+    out += fmt::format(
+        "{}\n  {{\"obj_id\": {}, \"scale\": {:.4f}, \"cam_R_m2c\": [{}, {}, {}, {}, {}, {}, {}, {}, {}], "
+        "\"cam_t_m2c\": [{}, {}, {}]}}",
+        i ? "," : "", c.obj_id, c.scale, R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1),
+        R(2, 2), 1e3f * c.pose.t.x(), 1e3f * c.pose.t.y(), 1e3f * c.pose.t.z());
+  }
+  return out + "\n]\n";
+}
+
 ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, std::mt19937& rng) {
   ImageScene s;
   float diameter = 0.f;  // of the largest part
@@ -178,6 +226,7 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
     s.obj_ids.push_back(order[i] + 1);
     obstacles.push_back(orientedBox(*meshes[i], *poses[i]));
   }
+  if (p.scaled_copies > 0) addScaledCopies(s, p, models, placement, obstacles, rng);
   // Clutter no larger than the parts when they are small (below 10 cm, where it used to dwarf them).
   addClutter(s, p, placement, obstacles, std::min(1.f, diameter / 0.1f), rng);
   if (placement.layout == Layout::Bin) {
@@ -299,6 +348,21 @@ DepthNoiseParams synthNoise(const SensorParams& sensor) {
   return n;
 }
 
+DepthNoiseParams closeRangeNoise() {
+  DepthNoiseParams n = synthNoise(sensorProfile("close-range"));
+  n.matching_window_px = 9;
+  n.edge_dropout = 0.5f;
+  n.specular_lobe_deg = 20.f;
+  n.specular_dropout = 0.9f;
+  n.metal_dropout = 0.15f;
+  n.max_range_m = 1.5f;
+  return n;
+}
+
+DepthNoiseParams synthNoise(const std::string& sensor_name_or_file) {
+  return sensor_name_or_file == "close-range" ? closeRangeNoise() : synthNoise(sensorProfile(sensor_name_or_file));
+}
+
 namespace {
 
 /// Image `index` of a dataset: its scene, the rendering and the sensor frame, all drawn from
@@ -318,8 +382,10 @@ RenderedImage renderImage(const GpuContext& ctx, const SynthParams& p, const std
   out.scene = p.poses == "random" ? randomScene(p, models, rng)
                                   : tejaniScene(p, models[m], static_cast<int>(m) + 1, tejani_poses, rng);
   out.rendering = renderScene(ctx, out.scene.objects, camera);
+  if (p.metal_parts) markMetal(out.rendering, 0, out.scene.partsEnd());
   applyLighting(out.rendering, randomLighting(out.scene.camera_T_world, rng));
   out.frame = sensorFrame(out.rendering, p.noise, static_cast<uint32_t>(rng()));
+  if (p.greyscale) toGreyscale(out.frame);
   return out;
 }
 
@@ -345,6 +411,15 @@ void validateSynthParams(const SynthParams& p) {
     throw InputError(fmt::format("instances per mesh {}..{}: need 0 <= min <= max <= 50", p.min_instances,
                                  p.max_instances));
   if (p.clutter < 0 || p.clutter > 50) throw InputError(fmt::format("clutter {} is outside 0..50", p.clutter));
+  if (p.scaled_copies < 0 || p.scaled_copies > 50)
+    throw InputError(fmt::format("scaled copies {} is outside 0..50", p.scaled_copies));
+  if (p.scaled_copies > 0 && p.poses != "random")
+    throw InputError("scaled copies are placed among random placements: use them with --poses random");
+  const DepthNoiseParams& n = p.noise;
+  if (n.matching_window_px < 0 || n.matching_window_px > 31 || !(n.specular_dropout >= 0.f && n.specular_dropout <= 1.f) ||
+      !(n.metal_dropout >= 0.f && n.metal_dropout <= 1.f) || !(n.specular_lobe_deg >= 0.f && n.specular_lobe_deg <= 90.f))
+    throw InputError("sensor noise: the matching window is 0 to 31 pixels, dropouts are shares of 0 to 1 and the "
+                     "specular lobe 0 to 90 degrees");
   for (const int id : p.symmetric)
     if (id < 1 || id > static_cast<int>(p.meshes.size()))
       throw InputError(fmt::format("--symmetric {}: obj_ids are 1..{} (the meshes in order)", id, p.meshes.size()));
@@ -465,6 +540,11 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
       fs::create_directories(scene_dir / "bin");
       writeTextFile((scene_dir / "bin" / fmt::format("{:06d}.json", i)).string(), binJson(*s.bin), false);
     }
+    if (p.scaled_copies > 0) {  // where the scaled copies are, for `vkpose eval` (not a BOP file)
+      fs::create_directories(scene_dir / "scaled");
+      writeTextFile((scene_dir / "scaled" / fmt::format("{:06d}.json", i)).string(), scaledCopiesJson(s.copies),
+                    false);
+    }
     if (progress) progress(i + 1, p.images);
   }
   writeTextFile((scene_dir / "scene_gt.json").string(), sceneGtJson(gt), false);
@@ -481,6 +561,52 @@ std::optional<BinBox> loadSynthBin(const BopImage& image) {
       fs::path(image.rgb_path).parent_path().parent_path() / "bin" / fmt::format("{:06d}.json", image.image_id);
   if (!fs::exists(file)) return std::nullopt;
   return loadBin(file.string());
+}
+
+std::vector<ScaledCopy> loadScaledCopies(const BopImage& image) {
+  const fs::path file =
+      fs::path(image.rgb_path).parent_path().parent_path() / "scaled" / fmt::format("{:06d}.json", image.image_id);
+  if (!fs::exists(file)) return {};
+  std::ifstream in(file);
+  std::vector<ScaledCopy> out;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& c : j) {
+      ScaledCopy copy;
+      copy.obj_id = c.at("obj_id").get<int>();
+      copy.scale = c.at("scale").get<float>();
+      const auto R = c.at("cam_R_m2c").get<std::vector<float>>();
+      const auto t = c.at("cam_t_m2c").get<std::vector<float>>();
+      if (R.size() != 9 || t.size() != 3) throw InputError("cam_R_m2c needs 9 numbers and cam_t_m2c 3");
+      for (int k = 0; k < 9; ++k) copy.pose.R(k / 3, k % 3) = R[static_cast<std::size_t>(k)];
+      copy.pose.t = 1e-3f * Eigen::Vector3f(t[0], t[1], t[2]);
+      out.push_back(copy);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not a list of scaled copies ({})", file.string(), e.what()));
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", file.string(), e.what()));
+  }
+  return out;
+}
+
+int scaledCopiesReported(const std::vector<ScaledCopy>& copies, const std::vector<Detection>& detections,
+                         const std::vector<TemplateBank>& banks, const std::map<int, int>& banks_by_obj_id,
+                         float min_score) {
+  int reported = 0;
+  for (const ScaledCopy& c : copies) {
+    const auto it = banks_by_obj_id.find(c.obj_id);
+    if (it == banks_by_obj_id.end()) continue;
+    const TemplateBank& bank = banks[static_cast<std::size_t>(it->second)];
+    const Eigen::Vector3f centre = bank.mesh.bboxCentre();
+    const Eigen::Vector3f copy_centre = c.pose.R * (c.scale * centre) + c.pose.t;
+    const bool hit = std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
+      return d.bank == it->second && d.score >= min_score &&
+             (d.pose.R * centre + d.pose.t - copy_centre).norm() < 0.25f * bank.diameter;
+    });
+    reported += hit ? 1 : 0;
+  }
+  return reported;
 }
 
 SynthImage synthesizeImage(const GpuContext& ctx, const SynthParams& params, const std::vector<Mesh>& models,

@@ -122,6 +122,13 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
   EXPECT_EQ(ideal.axial_sigma_at_1m, 0.f);
   EXPECT_EQ(ideal.holes, 0);
   EXPECT_EQ(ideal.edge_dropout, 0.f);
+  // synth --sensor NAME: the profile's noise; close-range adds a stereo camera's window and metal's holes.
+  const DepthNoiseParams close = synthNoise("close-range");
+  EXPECT_EQ(close.axial_sigma_at_1m, sensorProfile("close-range").axial_sigma_at_1m);
+  EXPECT_EQ(close.matching_window_px, 9);
+  EXPECT_GT(close.specular_dropout, 0.f);
+  EXPECT_EQ(synthNoise("kinect").matching_window_px, 0);
+  EXPECT_EQ(synthNoise("kinect").specular_dropout, 0.f);
   // A noisier sensor makes a small part's lengths coarser at the same distance.
   DetectorParams p;
   p.sensor = d435;
@@ -143,7 +150,7 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message("kinnect").find("kinect, primesense, realsense-d435, ideal"), std::string::npos);
+  EXPECT_NE(message("kinnect").find("kinect, primesense, realsense-d435, close-range, ideal"), std::string::npos);
   EXPECT_NE(message(bad).find("unknown key \"sigma\""), std::string::npos);
 }
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -57,6 +58,34 @@ TEST(ProceduralMeshes, SizesAndOutwardNormals) {
     EXPECT_GT(agree, 0.99 * static_cast<double>(m.faces.size()));
     EXPECT_GT(volume, 1e-4) << "a solid of more than 100 cm^3";
   }
+}
+
+TEST(ProceduralMeshes, PartsOfAPileHaveTheirSizesAndAreSolids) {
+  // name, diameter (metres, +-5 %), and the volume of the solid (m^3, +-10 %).
+  const std::vector<std::tuple<std::string, float, double>> expected = {
+      {"hex_nut", 0.0125f, 2.598 * std::pow(5.77e-3, 2) * 5e-3 - 2.598 * std::pow(3.2e-3, 2) * 5e-3},
+      {"cap_screw", 0.048f, M_PI * (2.75e-3 * 2.75e-3 * 3e-3 + 1.5e-3 * 1.5e-3 * 45e-3)},
+      {"nozzle", 0.059f, M_PI * (49e-6 * 8e-3 + 100e-6 * 4e-3 + 42.25e-6 * 33e-3) + M_PI / 3 * 13e-3 * (42.25e-6 + 19.5e-6 + 9e-6)},
+      {"spark_plug_key", 0.171f, M_PI * (121e-6 * 70e-3 + 64e-6 * 20e-3 + 25e-6 * 170e-3)},
+  };
+  const std::vector<Mesh> parts = partMeshes();
+  ASSERT_EQ(parts.size(), expected.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Mesh& m = parts[i];
+    const auto& [name, diameter, volume] = expected[i];
+    SCOPED_TRACE(name);
+    EXPECT_EQ(m.name, name);
+    EXPECT_NEAR(m.diameter, diameter, 0.05f * diameter);
+    EXPECT_NEAR(m.bbox_min.z(), 0.f, 1e-4f) << "stands on its base at z = 0";
+    ASSERT_EQ(m.colours.size(), m.vertices.size());
+    double v = 0;
+    for (const auto& f : m.faces) v += m.vertices[f[0]].dot(m.vertices[f[1]].cross(m.vertices[f[2]])) / 6.0;
+    EXPECT_GT(v, 0.0) << "outward faces";
+    if (name != "spark_plug_key") {  // the key's bar and neck overlap
+      EXPECT_NEAR(v, volume, 0.1 * volume);
+    }
+  }
+  EXPECT_TRUE(isSmallPart(parts[0].diameter) && !isSmallPart(parts[3].diameter));
 }
 
 TEST(ProceduralMeshes, LatheIsClosedAroundItsAxis) {

@@ -476,5 +476,114 @@ TEST(SynthCloseRange, SmallPartsInABinSeenFromClose) {
   EXPECT_THROW(validateSynthParams(params), InputError);
 }
 
+// ---- the close-range sensor (issue 51) ----------------------------------------------------
+
+/// A plane 0.4 m away with a bar `bar_px` pixels wide standing 2 cm in front of it, across the image.
+cv::Mat planeWithBar(int bar_px) {
+  cv::Mat depth(60, 80, CV_32FC1, cv::Scalar(0.4f));
+  depth(cv::Rect(40 - bar_px / 2, 0, bar_px, 60)).setTo(0.38f);
+  return depth;
+}
+
+TEST(SynthCloseRange, AMatchingWindowLosesThinPartsAndKeepsWideOnes) {
+  // A 9-pixel window: a bar 3 pixels wide (a screw's shank) merges into the plane behind it; one
+  // 15 pixels wide keeps its depth in the middle, and the plane away from it is untouched.
+  const cv::Mat thin = windowMedianDepth(planeWithBar(3), 9), wide = windowMedianDepth(planeWithBar(15), 9);
+  EXPECT_FLOAT_EQ(thin.at<float>(30, 40), 0.4f) << "the thin bar is gone";
+  EXPECT_FLOAT_EQ(wide.at<float>(30, 40), 0.38f) << "the wide bar stays";
+  EXPECT_FLOAT_EQ(wide.at<float>(30, 10), 0.4f);
+  const cv::Mat same = windowMedianDepth(planeWithBar(3), 1);
+  EXPECT_FLOAT_EQ(same.at<float>(30, 40), 0.38f) << "no window, no change";
+  // Mostly empty windows read nothing; a single hole in a plane is filled.
+  cv::Mat holes(40, 40, CV_32FC1, cv::Scalar(0.f));
+  holes(cv::Rect(0, 0, 10, 40)).setTo(0.5f);
+  holes.at<float>(20, 3) = 0.f;
+  const cv::Mat h = windowMedianDepth(holes, 5);
+  EXPECT_FLOAT_EQ(h.at<float>(20, 3), 0.5f);
+  EXPECT_FLOAT_EQ(h.at<float>(20, 30), 0.f);
+}
+
+TEST(SynthCloseRange, MetalShinesAndLosesDepthWhereItFacesTheCamera) {
+  // A steel plate facing the camera beside a matte one: with the close-range sensor the metal
+  // plate's depth is mostly lost (the projector's pattern mirrors straight back), the matte one
+  // keeps nearly all; lit alike, the metal is brighter where it faces the lamp by the lens.
+  const Mesh plate = cuboidMesh({0.06f, 0.06f, 0.005f}, {0.6f, 0.6f, 0.6f});
+  std::vector<SceneObject> objects(2);
+  objects[0].mesh = objects[1].mesh = &plate;
+  objects[0].pose.t = Eigen::Vector3f(-0.05f, 0.f, 0.4f);
+  objects[1].pose.t = Eigen::Vector3f(0.05f, 0.f, 0.4f);
+  Camera camera;
+  SceneRendering scene = renderScene(test::context(), objects, camera);
+  markMetal(scene, 0, 1);
+  ASSERT_GT(cv::countNonZero(scene.metal), 500);
+  EXPECT_EQ(cv::countNonZero(scene.metal & (scene.instance == 2)), 0);
+  Lighting light;
+  light.direction = Eigen::Vector3f(0.3f, 0.3f, 1.f).normalized();
+  applyLighting(scene, light);
+  const LinemodFrame frame = sensorFrame(scene, closeRangeNoise(), 5);
+  const cv::Mat metal = scene.instance == 1, matte = scene.instance == 2;
+  const double metal_read = cv::countNonZero(metal & (frame.depth_mm > 0)) / static_cast<double>(cv::countNonZero(metal));
+  const double matte_read = cv::countNonZero(matte & (frame.depth_mm > 0)) / static_cast<double>(cv::countNonZero(matte));
+  EXPECT_LT(metal_read, 0.3);
+  EXPECT_GT(matte_read, 0.8);
+  EXPECT_GT(cv::mean(scene.bgr, metal)[1], cv::mean(scene.bgr, matte)[1] + 40.0);
+  const cv::Vec3b c = scene.bgr.at<cv::Vec3b>(static_cast<int>(camera.cy), static_cast<int>(camera.cx - 0.05 * camera.fx / 0.4));
+  EXPECT_TRUE(c[0] == c[1] && c[1] == c[2]) << "bare metal is grey";
+}
+
+TEST(SynthCloseRange, GreyCamerasAndScaledCopiesInADataset) {
+  SynthParams p = smallParams(3);
+  p.images = 2;
+  p.placement.layout = Layout::Bin;
+  p.scaled_copies = 2;
+  p.greyscale = true;
+  p.metal_parts = true;
+  p.noise = closeRangeNoise();
+  const fs::path dir = freshDir("copies");
+  generateSyntheticDataset(test::context(), p, dir.string(), false);
+  const BopDataset data = loadBopDataset(dir.string(), "test");
+  ASSERT_EQ(data.images.size(), 2u);
+  int copies = 0;
+  for (const BopImage& im : data.images) {
+    const std::vector<ScaledCopy> scaled = loadScaledCopies(im);
+    copies += static_cast<int>(scaled.size());
+    for (const ScaledCopy& c : scaled) {
+      EXPECT_EQ(c.obj_id, 1);
+      EXPECT_TRUE((c.scale >= 0.8f && c.scale <= 0.9f) || (c.scale >= 1.1f && c.scale <= 1.2f)) << c.scale;
+      EXPECT_NEAR(c.pose.R.determinant(), 1.f, 1e-3f);
+      for (const GroundTruthPose& g : im.gt) EXPECT_GT((g.t - c.pose.t).norm(), 0.005f) << "not in the ground truth";
+    }
+    const cv::Mat rgb = cv::imread(im.rgb_path, cv::IMREAD_COLOR);
+    std::vector<cv::Mat> ch;
+    cv::split(rgb, ch);
+    EXPECT_EQ(cv::countNonZero(ch[0] != ch[1]) + cv::countNonZero(ch[1] != ch[2]), 0) << "a grey camera";
+  }
+  EXPECT_GE(copies, 2) << "copies find room in the bin";
+
+  // A detection at a copy's centre counts as reporting it; one elsewhere, or under the score, does not.
+  TemplateBank bank;
+  bank.mesh = test::lShapeMesh();
+  bank.diameter = bank.mesh.diameter;
+  ScaledCopy copy{1, 1.15f, {}};
+  copy.pose.t = Eigen::Vector3f(0.f, 0.f, 0.5f);
+  Detection on_it;
+  on_it.score = 0.7f;
+  on_it.pose.t = copy.pose.t + 0.15f * bank.mesh.bboxCentre();  // the centres of part and copy agree
+  Detection aside = on_it;
+  aside.pose.t.x() += bank.diameter;
+  Detection weak = on_it;
+  weak.score = 0.3f;
+  const std::map<int, int> index{{1, 0}};
+  EXPECT_EQ(scaledCopiesReported({copy}, {on_it}, {bank}, index, 0.5f), 1);
+  EXPECT_EQ(scaledCopiesReported({copy}, {aside, weak}, {bank}, index, 0.5f), 0);
+  EXPECT_EQ(scaledCopiesReported({copy}, {on_it}, {bank}, {{2, 0}}, 0.5f), 0) << "another object's copy";
+
+  p.scaled_copies = 51;
+  EXPECT_THROW(validateSynthParams(p), InputError);
+  p.scaled_copies = 1;
+  p.noise.matching_window_px = 40;
+  EXPECT_THROW(validateSynthParams(p), InputError);
+}
+
 }  // namespace
 }  // namespace vkpose
