@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The metal piles of issue 51: four small bare-metal parts (assets/parts: an M6 hex nut 12.5 mm
 # across, an M3 cap screw 48 mm long, a 58 mm nozzle and a 170 mm spark-plug key), 2-4 of each
-# piled to a bin and seen from 0.3-0.45 m by the close-range sensor (`synth --sensor close-range
-# --metal`: a stereo camera's matching window, holes where metal faces it, metal highlights).
+# piled to a bin (the screw and the nozzle scored with ADI: bodies of revolution). The camera is
+# 0.4-0.5 m from the bin's floor, so the parts on the pile are 0.3-0.5 m away (the distances
+# trained), and renders as the close-range sensor (`synth --sensor close-range --metal`: a stereo
+# camera's matching window, holes where metal faces it, metal highlights).
 # Each part's bank is trained as a user would (`--units mm --radii 0.3:0.5:0.05`, nothing else);
 # a part that train refuses as too small gets no bank, and so no detection. Each seed's set is
 # evaluated counting the parts 60 % or more visible (`--min-visib 0.6`), per kind.
@@ -14,7 +16,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 vkpose="${VKPOSE:-$root/build/release/vkpose}"
-[ $# -ge 1 ] || { sed -n 2,13p "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n 2,14p "$0"; exit 2; }
 out="$1"; shift
 seeds=("${@:-61 62}")
 copies="${COPIES:-0}"
@@ -38,7 +40,8 @@ for seed in ${seeds[@]}; do
   set="$out/pile$seed"
   [ "$copies" -gt 0 ] && set="${set}_copies$copies"
   [ -d "$set" ] || "$vkpose" synth "${meshes[@]}" --units mm --poses random --layout bin --instances 2:4 \
-    --camera-distance 0.3:0.45 --sensor close-range --metal --scaled-copies "$copies" --images "$images" \
+    --camera-distance 0.4:0.5 --sensor close-range --metal --symmetric 2 --symmetric 3 \
+    --scaled-copies "$copies" --images "$images" \
     --seed "$seed" --out "$set"
   "$vkpose" eval --dataset "$set" "${banks[@]}" --method vkpose --sensor close-range --min-visib 0.6 \
     --report "$set-report.json" --out "$set-results.csv" --force

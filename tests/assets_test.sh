@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # assets/ matches the code: the default config is what `vkpose config --print-defaults` prints,
-# and the demo's meshes and parts are what `vkpose demo --write-meshes` and `--write-parts` write,
-# byte for byte (the camera
-# files are read by the Assets.CameraFilesAreValidCameras test). Regenerate with
-# scripts/update-assets.sh.
+# and the demo's meshes and the parts are what `vkpose demo --write-meshes` and `--write-parts`
+# write, byte for byte (the camera files are read by the Assets.CameraFilesAreValidCameras test).
+# Regenerate with scripts/update-assets.sh.
 set -euo pipefail
 vkpose="$1"; root="$2"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT

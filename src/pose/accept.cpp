@@ -188,6 +188,10 @@ std::string stageEightShortfall(const PoseCandidate& c) {
     return fmt::format("only {:.0f}% of its visible outline meets an edge in the image (at least {:.0f}%): "
                        "something else of its size?",
                        100 * e.contour_edges, 100 * vp.min_contour_edges);
+  if (e.scaled_outline_support > e.outline_support + vp.size_probe_margin)
+    return fmt::format("its outline fits better 15% larger or smaller ({:.0f}% against {:.0f}% at its own size): "
+                       "a look-alike of another size?",
+                       100 * e.scaled_outline_support, 100 * e.outline_support);
   return {};
 }
 

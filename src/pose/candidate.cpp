@@ -367,6 +367,33 @@ void refineCandidates(std::vector<PoseCandidate>& candidates, const std::vector<
   });
 }
 
+namespace {
+/// PoseEvidence::scaled_outline_support: the best outline support of `model` (camera frame)
+/// scaled by 1/1.15 and by 1.15 about its centroid, and moved across the view by the size
+/// change either way (ICP lays the part against one side of a look-alike of another size).
+float scaledOutlineSupport(const PointCloud& model, const PoseFrame& frame, const VerifyParams& params) {
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+  for (const auto& p : model) centre += p;
+  centre /= static_cast<float>(std::max<std::size_t>(1, model.size()));
+  float radius = 0.f;  // across the view
+  for (const auto& p : model) radius = std::max(radius, (p - centre).head<2>().norm());
+  float best = 0.f;
+  for (const float s : {1.f / 1.15f, 1.15f}) {
+    const float shift = std::abs(s - 1.f) * radius;
+    for (const Eigen::Vector3f& d : {Eigen::Vector3f(0.f, 0.f, 0.f), Eigen::Vector3f(shift, 0.f, 0.f),
+                                     Eigen::Vector3f(-shift, 0.f, 0.f), Eigen::Vector3f(0.f, shift, 0.f),
+                                     Eigen::Vector3f(0.f, -shift, 0.f)}) {
+      PointCloud scaled(model.size());
+      for (std::size_t i = 0; i < model.size(); ++i) scaled[i] = centre + d + s * (model[i] - centre);
+      const auto outline = outlineSamples(scaled, frame.camera, frame.depth_m.size());
+      best = std::max(best, 0.5f * (contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump) +
+                                    silhouetteSupport(outline, frame.depth_m, params.silhouette_jump)));
+    }
+  }
+  return best;
+}
+}  // namespace
+
 PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const PointCloud& scene_points,
                          const PoseFrame& frame, const VerifyParams& params, bool with_cells) {
   const PointCloud model = transformed(model_points, pose);
@@ -376,7 +403,11 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
   const auto outline = outlineSamples(model, frame.camera, frame.depth_m.size());
   e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump);
   e.contour_edges = contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump);
-  if (with_cells) e.explained = supportCells(model, frame.depth_m, frame.camera, params.see_through_tolerance);
+  e.outline_support = 0.5f * (e.contour_edges + e.silhouette_support);
+  if (with_cells) {
+    e.explained = supportCells(model, frame.depth_m, frame.camera, params.see_through_tolerance);
+    if (params.size_probe_margin < 1.f) e.scaled_outline_support = scaledOutlineSupport(model, frame, params);
+  }
   return e;
 }
 
