@@ -41,13 +41,21 @@ struct PickCheck {
   std::vector<std::string> problems;  ///< "scene S image I: why"
 };
 
+/// The banks as a list in obj_id order (a detection's bank index) and obj_id -> that index,
+/// shared by the callbacks that outlive this call.
+std::pair<std::shared_ptr<std::vector<TemplateBank>>, std::shared_ptr<std::map<int, int>>> banksInObjIdOrder(
+    const std::map<int, TemplateBank>& banks) {
+  auto bank_list = std::make_shared<std::vector<TemplateBank>>();
+  auto index = std::make_shared<std::map<int, int>>();
+  for (const auto& [obj_id, bank] : banks) (*index)[obj_id] = static_cast<int>(bank_list->size()), bank_list->push_back(bank);
+  return {bank_list, index};
+}
+
 /// An on_detections callback that plans each image's picks (its bin from SCENE/bin/IMAGE.json
 /// when synth wrote one) and checks the first against the ground truth.
 std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> pickChecker(
     const EvalOptions& opt, const std::map<int, TemplateBank>& banks, PickCheck& check) {
-  auto bank_list = std::make_shared<std::vector<TemplateBank>>();
-  auto index = std::make_shared<std::map<int, int>>();  // obj_id -> bank index (obj_id order)
-  for (const auto& [obj_id, bank] : banks) (*index)[obj_id] = static_cast<int>(bank_list->size()), bank_list->push_back(bank);
+  const auto [bank_list, index] = banksInObjIdOrder(banks);
   auto grasps =
       std::make_shared<std::vector<std::vector<Grasp>>>(graspsForBanks(opt.grasps, *bank_list, opt.pick.symmetry_steps));
   const PickParams pick = opt.pick;
@@ -79,9 +87,7 @@ struct CopyCheck {
 std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> copyChecker(
     const std::map<int, TemplateBank>& banks, CopyCheck& check,
     std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> next) {
-  auto bank_list = std::make_shared<std::vector<TemplateBank>>();
-  auto index = std::make_shared<std::map<int, int>>();  // obj_id -> bank index (obj_id order)
-  for (const auto& [obj_id, bank] : banks) (*index)[obj_id] = static_cast<int>(bank_list->size()), bank_list->push_back(bank);
+  const auto [bank_list, index] = banksInObjIdOrder(banks);
   return [bank_list, index, &check, next](const BopImage& im, const LinemodFrame& frame, const DetectionResult& result) {
     const std::vector<ScaledCopy> copies = loadScaledCopies(im);
     check.copies += static_cast<int>(copies.size());
