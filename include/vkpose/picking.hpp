@@ -168,9 +168,19 @@ Eigen::Vector3f approachAxis(const PickParams& params, const std::optional<BinBo
 
 /// One instance of a scene whose truth is known (a synthetic frame's ground truth).
 struct TruthInstance {
-  int bank = -1;  ///< index into the banks: the object
-  Pose pose;      ///< object-to-camera
+  int bank = -1;            ///< index into the banks: the object
+  Pose pose;                ///< object-to-camera
+  float visib_fract = 1.f;  ///< visible share of its silhouette (BOP scene_gt_info.json)
 };
+
+/// What a perfect detector would be offered: the plan for the true instances themselves (each a
+/// detection of score 1 at its true pose) against the same depth, bin and grasps, keeping only
+/// the picks of instances at least `min_visib` visible (the others stay obstacles). No pick in
+/// it means nothing in the frame can be taken: every instance is buried, out of reach or
+/// hemmed in, and "no pick" is then the right answer.
+PickPlan truthPickPlan(const std::vector<TruthInstance>& truth, const std::vector<TemplateBank>& banks,
+                       const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
+                       const std::optional<BinBox>& bin, const PickParams& params, float min_visib = 0.f);
 
 /// Why the plan's first pick would fail in the true scene, empty when it would not: no pick;
 /// its detection is not within `max_error` diameters of a true instance of its object (mean

@@ -38,6 +38,10 @@ struct EvalOptions {
 /// The first picks of a run, checked against each image's ground truth.
 struct PickCheck {
   int frames = 0, ok = 0;
+  /// Images where not even the true instances could be taken (truthPickPlan: buried, out of
+  /// reach, hemmed in, or less visible than --min-visib), and of those the ones left alone:
+  /// no pick there is right.
+  int nothing_to_pick = 0, left_alone = 0;
   std::vector<std::string> problems;  ///< "scene S image I: why"
 };
 
@@ -59,8 +63,9 @@ std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)
   auto grasps =
       std::make_shared<std::vector<std::vector<Grasp>>>(graspsForBanks(opt.grasps, *bank_list, opt.pick.symmetry_steps));
   const PickParams pick = opt.pick;
-  return [bank_list, index, grasps, pick, &check](const BopImage& im, const LinemodFrame& frame,
-                                                   const DetectionResult& result) {
+  const float min_visib = opt.params.eval.min_visib_fract;
+  return [bank_list, index, grasps, pick, min_visib, &check](const BopImage& im, const LinemodFrame& frame,
+                                                              const DetectionResult& result) {
     cv::Mat depth_m;
     frame.depth_mm.convertTo(depth_m, CV_32F, 0.001);
     const std::optional<BinBox> bin = loadSynthBin(im);
@@ -69,9 +74,20 @@ std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)
     const PickPlan plan = planPicks(result.detections, *bank_list, *grasps, depth_m, camera, bin, pick);
     std::vector<TruthInstance> truth;
     for (const GroundTruthPose& g : im.gt)
-      if (const auto it = index->find(g.obj_id); it != index->end()) truth.push_back({it->second, {g.R, g.t}});
-    const std::string problem = firstPickProblem(plan, result.detections, *bank_list, truth, bin);
+      if (const auto it = index->find(g.obj_id); it != index->end())
+        truth.push_back({it->second, {g.R, g.t}, g.visib_fract});
+    std::string problem = firstPickProblem(plan, result.detections, *bank_list, truth, bin);
+    const PickPlan possible = truthPickPlan(truth, *bank_list, *grasps, depth_m, camera, bin, pick, min_visib);
     ++check.frames;
+    if (possible.picks.empty()) ++check.nothing_to_pick;
+    if (possible.picks.empty() && problem == "no pick") {
+      ++check.left_alone;
+      problem.clear();
+    } else if (problem == "no pick") {
+      const Pick& p = possible.picks.front();
+      problem = fmt::format("no pick, where true instance {} ({:.0f} % visible) could be taken by grasp '{}'",
+                            p.detection, 100.f * truth[static_cast<std::size_t>(p.detection)].visib_fract, p.grasp.name);
+    }
     if (problem.empty()) ++check.ok;
     else check.problems.push_back(fmt::format("scene {} image {}: {}", im.scene_id, im.image_id, problem));
   };
@@ -217,8 +233,16 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
              report.objects.size() == 1 ? "" : "s", criterion, report.device);
   fmt::print("{}", evalReportTable(report));
   if (!opt.grasps.empty()) {
-    fmt::print("first pick ({}): right and clear in {} of {} images ({:.1f} %)\n", opt.pick_order, picks.ok,
-               picks.frames, picks.frames > 0 ? 100.0 * picks.ok / picks.frames : 0.0);
+    fmt::print("first pick ({}): right in {} of {} images ({:.1f} %): {} right and clear, {} with nothing a gripper "
+               "could take left alone\n",
+               opt.pick_order, picks.ok, picks.frames, picks.frames > 0 ? 100.0 * picks.ok / picks.frames : 0.0,
+               picks.ok - picks.left_alone, picks.left_alone);
+    if (picks.nothing_to_pick > 0)
+      fmt::print("  ({} image{} had nothing a gripper could take, even at the true poses{})\n", picks.nothing_to_pick,
+                 picks.nothing_to_pick == 1 ? "" : "s",
+                 params.eval.min_visib_fract > 0.f
+                     ? fmt::format(", of instances at least {:.0f} % visible", 100.f * params.eval.min_visib_fract)
+                     : "");
     for (const std::string& p : picks.problems) fmt::print("  {}\n", p);
   }
   if (copies.copies > 0)
@@ -230,6 +254,7 @@ ExitCode runEval(const EvalOptions& opt, const GlobalOptions& global) {
       nlohmann::json doc = nlohmann::json::parse(json);
       if (!opt.grasps.empty())
         doc["picks"] = {{"order", opt.pick_order}, {"images", picks.frames}, {"first_pick_ok", picks.ok},
+                        {"nothing_to_pick", picks.nothing_to_pick}, {"left_alone", picks.left_alone},
                         {"problems", picks.problems}};
       if (copies.copies > 0) doc["scaled_copies"] = {{"copies", copies.copies}, {"reported", copies.reported}};
       json = doc.dump(2) + "\n";

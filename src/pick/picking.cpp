@@ -475,6 +475,23 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
   return plan;
 }
 
+PickPlan truthPickPlan(const std::vector<TruthInstance>& truth, const std::vector<TemplateBank>& banks,
+                       const std::vector<std::vector<Grasp>>& grasps, const cv::Mat& depth_m, const Camera& camera,
+                       const std::optional<BinBox>& bin, const PickParams& params, float min_visib) {
+  std::vector<Detection> instances;
+  for (const TruthInstance& t : truth) {
+    Detection d;
+    d.bank = t.bank;
+    d.object = banks.at(static_cast<std::size_t>(t.bank)).object;
+    d.score = 1.f;
+    d.pose = t.pose;
+    instances.push_back(d);
+  }
+  PickPlan plan = planPicks(instances, banks, grasps, depth_m, camera, bin, params);
+  std::erase_if(plan.picks, [&](const Pick& p) { return truth[static_cast<std::size_t>(p.detection)].visib_fract < min_visib; });
+  return plan;
+}
+
 std::string firstPickProblem(const PickPlan& plan, const std::vector<Detection>& detections,
                              const std::vector<TemplateBank>& banks, const std::vector<TruthInstance>& truth,
                              const std::optional<BinBox>& bin, float max_error) {

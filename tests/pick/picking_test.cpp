@@ -260,5 +260,24 @@ TEST(Picking, TheFirstPickIsCheckedAgainstTheTruth) {
   EXPECT_EQ(firstPickProblem({}, dets, {bank}, {}, std::nullopt), "no pick");
 }
 
+TEST(Picking, TheTruthTellsWhetherAnythingCouldBeTaken) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  // A can in the open: the true pose can be taken.
+  const PickPlan open = truthPickPlan({{0, lyingCan(0.f)}}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
+  ASSERT_EQ(open.picks.size(), 1u);
+  EXPECT_EQ(open.picks[0].detection, 0);
+  EXPECT_EQ(open.detections.size(), 1u);
+  // Under a board (the depth image 10 cm in front of it): nothing can be taken.
+  const cv::Mat board(480, 640, CV_32F, cv::Scalar(0.70f));
+  EXPECT_TRUE(truthPickPlan({{0, lyingCan(0.f)}}, {bank}, {grasps}, board, camera(), std::nullopt, {}).picks.empty());
+  // Less visible than asked for: an obstacle only. The other can, in sight, is taken.
+  const std::vector<TruthInstance> two = {{0, lyingCan(0.f), 0.3f}, {0, lyingCan(0.f, 0.2f), 0.9f}};
+  const PickPlan seen = truthPickPlan(two, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {}, 0.6f);
+  ASSERT_EQ(seen.picks.size(), 1u);
+  EXPECT_EQ(seen.picks[0].detection, 1);
+  EXPECT_TRUE(truthPickPlan({two[0]}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {}, 0.6f).picks.empty());
+}
+
 }  // namespace
 }  // namespace vkpose
