@@ -9,6 +9,7 @@
 
 #include "match/features.hpp"
 #include "render/render.hpp"
+#include "training/scattered.hpp"
 #include "training/training.hpp"
 #include "training/view_features.hpp"
 #include "util/parallel.hpp"
@@ -22,107 +23,14 @@ namespace vkpose {
 
 namespace {
 
-struct Candidate {
-  int x = 0, y = 0;
-  uint8_t bin = 0;
-  float score = 0.f;
-};
-
-/// LINEMOD's scattered selection: best first, each new feature at least `distance` from
-/// those already taken; the distance relaxes by one pixel after every pass. Each candidate's
-/// distance to the nearest taken feature is kept up to date, and passes that could take
-/// nothing are skipped, which gives the same choice as the plain loop in O(count * n).
-///
-/// Only the candidates within the current distance of a newly taken one are updated (found
-/// through a grid of 8 x 8 pixel buckets): a candidate farther away keeps a stale squared
-/// distance, but stale and true are then both at least the current distance^2, and that
-/// distance only shrinks, so every comparison (may it be taken, and the largest blocked
-/// distance left) comes out as with the true value.
-std::vector<Candidate> selectScattered(std::vector<Candidate> candidates, int count) {
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  if (static_cast<int>(candidates.size()) <= count) return candidates;
-  constexpr int kBucket = 8;
-  int min_x = INT32_MAX, min_y = INT32_MAX, max_x = INT32_MIN, max_y = INT32_MIN;
-  for (const auto& c : candidates) {
-    min_x = std::min(min_x, c.x);
-    min_y = std::min(min_y, c.y);
-    max_x = std::max(max_x, c.x);
-    max_y = std::max(max_y, c.y);
-  }
-  const int buckets_x = (max_x - min_x) / kBucket + 1, buckets_y = (max_y - min_y) / kBucket + 1;
-  auto bucketOf = [&](const Candidate& c) { return (c.y - min_y) / kBucket * buckets_x + (c.x - min_x) / kBucket; };
-  // Candidate indices by bucket (a counting sort).
-  std::vector<int> first(static_cast<std::size_t>(buckets_x) * buckets_y + 1, 0), members(candidates.size());
-  for (const auto& c : candidates) ++first[bucketOf(c) + 1];
-  for (std::size_t b = 1; b < first.size(); ++b) first[b] += first[b - 1];
-  {
-    std::vector<int> fill(first.begin(), first.end() - 1);
-    for (std::size_t i = 0; i < candidates.size(); ++i) members[fill[bucketOf(candidates[i])]++] = static_cast<int>(i);
-  }
-  std::vector<Candidate> chosen;
-  constexpr float kFar = 1e30f;
-  std::vector<float> nearest_sq(candidates.size(), kFar);  // < 0: taken
-  float distance = static_cast<float>(candidates.size() / static_cast<std::size_t>(count) + 1);
-  while (static_cast<int>(chosen.size()) < count) {
-    const float d2 = distance * distance;
-    const int reach = static_cast<int>(std::ceil(distance));
-    float best_left = -1.f;
-    for (std::size_t i = 0; i < candidates.size() && static_cast<int>(chosen.size()) < count; ++i) {
-      // Most candidates are blocked (or taken: -1): pass over blocks of 8 that hold none to
-      // take, keeping the largest blocked distance, without a branch per candidate.
-      for (; i + 8 <= candidates.size(); i += 8) {
-        bool any = false;
-        float most = best_left;
-        for (std::size_t k = i; k < i + 8; ++k) {
-          any |= nearest_sq[k] >= d2;
-          most = std::max(most, nearest_sq[k]);
-        }
-        if (any) break;
-        best_left = most;
-      }
-      if (i >= candidates.size()) break;
-      if (nearest_sq[i] < 0.f) continue;
-      if (nearest_sq[i] < d2) {
-        best_left = std::max(best_left, nearest_sq[i]);
-        continue;
-      }
-      const Candidate& taken = candidates[i];
-      chosen.push_back(taken);
-      nearest_sq[i] = -1.f;
-      const int bx0 = std::max(0, (taken.x - reach - min_x) / kBucket),
-                bx1 = std::min(buckets_x - 1, (taken.x + reach - min_x) / kBucket);
-      const int by0 = std::max(0, (taken.y - reach - min_y) / kBucket),
-                by1 = std::min(buckets_y - 1, (taken.y + reach - min_y) / kBucket);
-      for (int by = by0; by <= by1; ++by)
-        for (int bx = bx0; bx <= bx1; ++bx) {
-          const int b = by * buckets_x + bx;
-          for (int k = first[b]; k < first[b + 1]; ++k) {
-            const int j = members[k];
-            if (nearest_sq[j] < 0.f) continue;
-            const float dx = static_cast<float>(candidates[j].x - taken.x),
-                        dy = static_cast<float>(candidates[j].y - taken.y);
-            nearest_sq[j] = std::min(nearest_sq[j], dx * dx + dy * dy);
-          }
-        }
-    }
-    distance -= 1.f;  // at distance 1 every untaken candidate qualifies, so this ends
-    // Skip the passes that would take nothing: the next one that takes something is the
-    // first whose distance^2 is at most the largest distance^2 left (these are integers).
-    if (best_left >= 0.f && best_left < distance * distance)
-      distance = std::max(1.f, std::floor(std::sqrt(best_left) + 1e-4f));
-  }
-  return chosen;
-}
-
 /// Colour candidates: gradient labels on or next to the object (silhouette and inner edges)
 /// whose magnitude is a 5x5 local maximum above the strong threshold.
-std::vector<Candidate> colourCandidates(const cv::Mat& labels, const cv::Mat& magnitude_sq, const cv::Mat& mask,
+std::vector<FeatureCandidate> colourCandidates(const cv::Mat& labels, const cv::Mat& magnitude_sq, const cv::Mat& mask,
                                         float strong_threshold) {
   cv::Mat region;
   cv::dilate(mask, region, cv::Mat());
   const float strong_sq = strong_threshold * strong_threshold;
-  std::vector<Candidate> out;
+  std::vector<FeatureCandidate> out;
   for (int y = 2; y < labels.rows - 2; ++y)
     for (int x = 2; x < labels.cols - 2; ++x) {
       const uint8_t label = labels.at<uint8_t>(y, x);
@@ -145,7 +53,7 @@ std::vector<Candidate> colourCandidates(const cv::Mat& labels, const cv::Mat& ma
 /// Depth candidates: normal labels inside the mask eroded twice (away from the silhouette's
 /// unreliable normals), scored by the distance to the nearest change of label, so features
 /// sit in the middle of uniformly oriented surfaces.
-std::vector<Candidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mask) {
+std::vector<FeatureCandidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mask) {
   cv::Mat region;
   cv::erode(mask, region, cv::Mat(), cv::Point(-1, -1), 2);
   cv::Mat uniform = cv::Mat::zeros(labels.size(), CV_8UC1);
@@ -159,7 +67,7 @@ std::vector<Candidate> depthCandidates(const cv::Mat& labels, const cv::Mat& mas
     }
   cv::Mat distance;
   cv::distanceTransform(uniform, distance, cv::DIST_L2, 3);
-  std::vector<Candidate> out;
+  std::vector<FeatureCandidate> out;
   for (int y = 0; y < labels.rows; ++y)
     for (int x = 0; x < labels.cols; ++x) {
       const uint8_t l = labels.at<uint8_t>(y, x);
@@ -216,7 +124,7 @@ ExtractedTemplate selectFeatures(const QuantizedView& q, const cv::Mat& crop_mas
   const std::size_t levels = fp.T.size();
   const int x0 = roi.x, y0 = roi.y;
   cv::Mat mask = crop_mask;
-  std::vector<std::vector<Candidate>> chosen[kModalityCount];
+  std::vector<std::vector<FeatureCandidate>> chosen[kModalityCount];
   for (auto& c : chosen) c.resize(levels);
   for (std::size_t l = 0; l < levels; ++l) {
     if (l > 0) mask = downsampleLabels(mask);  // the pixels the depth labels keep
