@@ -4,6 +4,7 @@
 // pose stages (src/pose/) fill them, the detection JSON (docs/formats.md) writes them.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,6 +51,10 @@ struct Detection {
   float depth_fit = 0.f;       ///< share of the visible model points within tolerance of the scene depth
   float silhouette_support = 0.f;  ///< share of the outline with a depth step behind it
   float contour_edges = 0.f;       ///< share of the visible outline that meets an image edge along it
+  /// Share of the visible outline whose nearest image edge lies within 1.5 px of it (a right
+  /// pose's outline sits on the object's edges; a look-alike's strays where the shapes differ).
+  /// Picking asks for PickParams::min_outline_on_edges. NaN where not measured.
+  float outline_on_edges = std::numeric_limits<float>::quiet_NaN();
   /// Agreement (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
   /// where the pose fits the depth (appearanceAgreement): a correlation where the rendering
   /// shows several colours, a match of the colour itself where it shows one; 1 when not

@@ -109,6 +109,11 @@ struct PickParams {
   float part_tolerance_m = 0.005f;
   float clearance_m = 0.02f;  ///< free space around a grasp counts up to this
   int symmetry_steps = 36;    ///< copies of a grasp about a symmetric object's axis
+  /// A detection whose outline lies on the image's edges less than this (its
+  /// outline_on_edges) is not picked: a grasp needs a pose that sits on the part, and a
+  /// look-alike of the part's size (a cylinder taken for a cup) strays from the edges where
+  /// the shapes differ. 0: off; detections that did not measure it are not held back.
+  float min_outline_on_edges = 0.5f;
 };
 
 /// A grasp placed at a detection.

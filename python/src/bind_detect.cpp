@@ -188,6 +188,7 @@ py::dict detectionDict(const Detection& d) {
   out["explained_edges"] = tidy(d.explained_edges);
   out["silhouette_support"] = tidy(d.silhouette_support);
   out["contour_edges"] = tidy(d.contour_edges);
+  if (std::isfinite(d.outline_on_edges)) out["outline_on_edges"] = tidy(d.outline_on_edges);
   out["colour_agreement"] = tidy(d.colour_agreement);
   out["icp_fitness"] = d.icp_fitness;
   out["icp_iterations"] = d.icp_iterations;
@@ -380,6 +381,11 @@ leaves the config as it was.)")
                              "Colour only: share of the frame's edges under the pose's mask that the model's edges explain")
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
       .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
+      .def_property_readonly("outline_on_edges",
+                             [](const PyDetection& p) -> py::object {
+                               if (!std::isfinite(p.d.outline_on_edges)) return py::none();
+                               return py::float_(tidy(p.d.outline_on_edges));
+                             })
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
                              "Correlation of the rendered mesh's chromaticity with the frame's; 1 when not measured")
       .def_property_readonly("icp_fitness", [](const PyDetection& p) { return p.d.icp_fitness; },
@@ -599,12 +605,15 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
   m.def(
       "plan_picks",
       [](const PyResult& result, const py::object& grasps, const py::object& depth, const py::object& bin,
-         const std::string& order, float max_tilt, const py::object& approach_axis) {
+         const std::string& order, float max_tilt, const py::object& approach_axis, float min_outline_on_edges) {
         if (!result.frame) valueError("result: a Result of Detector.detect()");
         const auto& banks = result.frame->state->detector->banks();
         PickParams params;
         params.order = parsePickOrder(order);
         params.max_tilt_deg = max_tilt;
+        if (!(min_outline_on_edges >= 0.f && min_outline_on_edges <= 1.f))
+          valueError(fmt::format("min_outline_on_edges must be in [0, 1], not {}", min_outline_on_edges));
+        params.min_outline_on_edges = min_outline_on_edges;
         if (!approach_axis.is_none()) params.approach_axis = vector3Of(approach_axis, "approach_axis");
         std::vector<std::string> files;
         if (py::isinstance<py::str>(grasps) || py::hasattr(grasps, "__fspath__")) {
@@ -631,6 +640,7 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
       },
       py::arg("result"), py::arg("grasps"), py::arg("depth"), py::kw_only(), py::arg("bin") = py::none(),
       py::arg("order") = "combined", py::arg("max_tilt") = 45.f, py::arg("approach_axis") = py::none(),
+      py::arg("min_outline_on_edges") = 0.5f,
       R"(Bin picking on a Result, as `vkpose detect --grasps` does (docs/picking.md): each grasp file's
 grasps placed at the detections of its object, refused where the gripper would hit the bin, the
 scene or another detection, and the detections ordered into a pick list. Returns {"grasps": [per
@@ -639,7 +649,9 @@ detection {"valid": [...], "refused": [{"name", "reason"}]}], "picks": [{"detect
 
 grasps: a grasp file or a list of them. depth: the frame's depth (as detect() took it). bin: a
 bin file. order: combined, height, score or visible. max_tilt: degrees from approach_axis
-(default: down into the bin, or the camera's viewing direction (0, 0, 1) without one).)");
+(default: down into the bin, or the camera's viewing direction (0, 0, 1) without one).
+min_outline_on_edges: a detection is picked only when this share of its outline lies on the
+image's edges (Detection.outline_on_edges; 0: off).)");
 }
 
 }  // namespace vkpose::python

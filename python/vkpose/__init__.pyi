@@ -192,6 +192,8 @@ class Detection:
     @property
     def contour_edges(self) -> float: ...
     @property
+    def outline_on_edges(self) -> float | None: ...
+    @property
     def colour_agreement(self) -> float: ...
     @property
     def icp_fitness(self) -> float: ...
@@ -261,7 +263,8 @@ def draw(rgb: npt.NDArray[np.uint8], detections: Result | Sequence[Detection], *
 
 def plan_picks(result: Result, grasps: PathLike | Sequence[PathLike], depth: npt.NDArray[Any], *,
                bin: PathLike | None = None, order: str = "combined", max_tilt: float = 45.0,
-               approach_axis: Sequence[float] | None = None) -> dict[str, Any]:
+               approach_axis: Sequence[float] | None = None,
+               min_outline_on_edges: float = 0.5) -> dict[str, Any]:
     """Bin picking on a Result: valid and refused grasps per detection, and the pick list."""
 
 def load_frame(rgb: PathLike, depth: PathLike,

@@ -420,6 +420,12 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str()
       ->group(picking);
+  sub->add_option("--min-outline-fit", opt->pick.min_outline_on_edges,
+                  "A detection is picked only when this share of its outline lies on the image's edges (its "
+                  "outline_on_edges; 0: off)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(picking);
   sub->add_option("--approach-axis", opt->approach_axis,
                   "The robot's approach direction in the camera frame, 3 numbers (default: down into the --bin, or 0 0 1 along "
                   "the camera's view without one)")

@@ -322,6 +322,12 @@ void addPickingOptions(CLI::App* sub, EvalOptions& o) {
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str()
       ->group(picking);
+  sub->add_option("--min-outline-fit", opt->pick.min_outline_on_edges,
+                  "A detection is picked only when this share of its outline lies on the image's edges (its "
+                  "outline_on_edges; 0: off)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(picking);
 }
 
 /// What counts as a correct estimate, and which instances count.

@@ -1,4 +1,5 @@
 // The detection JSON and the overlay PNG.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -69,6 +70,7 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["depth_fit"] = round(d.depth_fit, 4);
     j["silhouette_support"] = round(d.silhouette_support, 4);
     j["contour_edges"] = round(d.contour_edges, 4);
+    if (std::isfinite(d.outline_on_edges)) j["outline_on_edges"] = round(d.outline_on_edges, 4);
     j["colour_agreement"] = round(d.colour_agreement, 4);
     j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision
     j["icp_iterations"] = d.icp_iterations;

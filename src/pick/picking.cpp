@@ -416,6 +416,17 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
     const Detection& d = detections[i];
     const auto b = static_cast<std::size_t>(d.bank);
     if (b >= grasps.size() || grasps[b].empty()) continue;
+    if (d.outline_on_edges < params.min_outline_on_edges) {  // false for NaN: not measured
+      const std::string why =
+          fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %): too "
+                      "uncertain a pose to grip, or something else of its size",
+                      100.f * d.outline_on_edges, 100.f * params.min_outline_on_edges);
+      std::vector<std::string> names;
+      for (const Grasp& g : grasps[b])
+        if (std::find(names.begin(), names.end(), g.name) == names.end()) names.push_back(g.name);
+      for (const std::string& name : names) plan.detections[i].refused.push_back({name, why});
+      continue;
+    }
     const NearestNeighbours own(parts[i].points, 0.005f);
     std::vector<const std::vector<Eigen::Vector3f>*> others;
     std::vector<std::size_t> other_index;

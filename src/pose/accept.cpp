@@ -67,6 +67,7 @@ Detection fittedDetection(const PoseCandidate& c, const RefineResult& fit, const
   d.depth_fit = e.depth.fits;
   d.silhouette_support = e.silhouette_support;
   d.contour_edges = e.contour_edges;
+  d.outline_on_edges = e.outline_on_edges;
   d.score = poseScore(e);
   placeInImage(d, c.initial.model_points, bank.centre, camera);
   return d;

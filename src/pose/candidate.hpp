@@ -72,6 +72,7 @@ struct PoseEvidence {
   /// the better of it with the model scaled by 1/1.15 and 1.15 about its centre (measured with
   /// the scene cells only): a look-alike of another size is explained better by another scale.
   float outline_support = 0.f, scaled_outline_support = 0.f;
+  float outline_on_edges = 0.f;  ///< outlineOnEdges: how closely the outline lies on the image's edges
 };
 
 /// One start of stages 6-8 and what each stage found for it.

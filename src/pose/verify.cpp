@@ -3,6 +3,7 @@
 #include "pose/verify.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <vector>
@@ -145,6 +146,51 @@ float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageE
     }
   }
   return usable ? static_cast<float>(met) / static_cast<float>(usable) : 0.f;
+}
+
+float outlineOnEdges(const std::vector<OutlineSample>& outline, const ImageEdges& edges, const cv::Mat& scene_depth_m,
+                     float jump, float min_gradient, float tolerance_px) {
+  CV_Assert(edges.dx.type() == CV_32FC1 && edges.dy.type() == CV_32FC1 && edges.dx.size() == scene_depth_m.size());
+  constexpr int kReach = 6;  // px each way along the normal
+  const float cos_max = std::cos(0.5236f);
+  const float min_sq = min_gradient * min_gradient;
+  std::size_t on = 0, usable = 0;
+  std::array<float, 2 * kReach + 3> across{};
+  for (const auto& [c, normal, model_z_in] : outline) {
+    // The samples contourEdgeSupport uses: no occluder in front, not at the image's border.
+    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
+    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+    if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) continue;
+    if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) continue;
+    if (!(c.x() >= kReach && c.y() >= kReach && c.x() < float(edges.dx.cols - kReach) &&
+          c.y() < float(edges.dx.rows - kReach)))
+      continue;
+    ++usable;
+    // |gradient . normal| at each step along the normal, 0 where it is weak or runs along.
+    across.fill(0.f);
+    for (int t = -kReach - 1; t <= kReach + 1; ++t) {
+      const Eigen::Vector2f q = c + static_cast<float>(t) * normal;
+      const int u = static_cast<int>(std::lround(q.x())), v = static_cast<int>(std::lround(q.y()));
+      if (u < 0 || v < 0 || u >= edges.dx.cols || v >= edges.dx.rows) continue;
+      const float gx = edges.dx.at<float>(v, u), gy = edges.dy.at<float>(v, u);
+      const float sq = gx * gx + gy * gy;
+      if (sq < min_sq) continue;
+      const float a = std::abs(gx * normal.x() + gy * normal.y());
+      if (a >= cos_max * std::sqrt(sq)) across[static_cast<std::size_t>(t + kReach + 1)] = a;
+    }
+    // The edge nearest the outline (a local maximum across it, looked for from 0 outward): the
+    // object's own edge when the pose is right, whatever stronger edges lie a few pixels off.
+    // The outline runs along the mask's outermost pixels, half a pixel inside the true edge.
+    for (int k = 0; k <= 2 * kReach; ++k) {
+      const int t = (k % 2 == 0) ? k / 2 : -(k + 1) / 2;
+      const std::size_t i = static_cast<std::size_t>(t + kReach + 1);
+      if (across[i] > 0.f && across[i] >= across[i - 1] && across[i] >= across[i + 1]) {
+        on += std::abs(static_cast<float>(t) - 0.5f) <= tolerance_px;
+        break;
+      }
+    }
+  }
+  return usable ? static_cast<float>(on) / static_cast<float>(usable) : 0.f;
 }
 
 DepthAgreement depthAgreement(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,

@@ -76,6 +76,13 @@ ImageEdges imageEdges(const cv::Mat& bgr);
 /// sample is usable.
 float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges, const cv::Mat& scene_depth_m,
                          const Camera& camera, float jump, float min_gradient = 20.f);
+/// How closely the outline lies on the image's edges: of the samples contourEdgeSupport uses,
+/// the share whose nearest edge across the outline (within 6 px) lies within `tolerance_px` of
+/// it. A right pose puts its outline on the object's own edges; a look-alike of about the same
+/// size (a cylinder taken for a tapered cup) meets edges within contourEdgeSupport's 2 px
+/// along most of its outline, but its nearest edges stray where the shapes differ.
+float outlineOnEdges(const std::vector<OutlineSample>& outline, const ImageEdges& edges, const cv::Mat& scene_depth_m,
+                     float jump, float min_gradient = 20.f, float tolerance_px = 1.5f);
 float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageEdges& edges,
                          const cv::Mat& scene_depth_m, float jump, float min_gradient = 20.f);
 

@@ -260,6 +260,26 @@ TEST(Picking, TheFirstPickIsCheckedAgainstTheTruth) {
   EXPECT_EQ(firstPickProblem({}, dets, {bank}, {}, std::nullopt), "no pick");
 }
 
+TEST(Picking, APoseWhoseOutlineStraysFromTheImagesEdgesIsNotPicked) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  Detection loose = detectionAt(lyingCan(0.f)), firm = loose, unmeasured = loose;
+  loose.outline_on_edges = 0.3f;
+  firm.outline_on_edges = 0.8f;
+  const PickPlan plan = planPicks({loose, firm, unmeasured}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
+  ASSERT_EQ(plan.detections.size(), 3u);
+  EXPECT_TRUE(plan.detections[0].valid.empty());
+  ASSERT_EQ(plan.detections[0].refused.size(), 1u);
+  EXPECT_EQ(plan.detections[0].refused[0].name, "side");
+  EXPECT_NE(plan.detections[0].refused[0].reason.find("outline lies on the image's edges for 30 %"), std::string::npos)
+      << plan.detections[0].refused[0].reason;
+  EXPECT_FALSE(plan.detections[1].valid.empty()) << "0.8 of its outline on edges";
+  EXPECT_FALSE(plan.detections[2].valid.empty()) << "not measured: not held back";
+  PickParams off;
+  off.min_outline_on_edges = 0.f;
+  EXPECT_FALSE(planPicks({loose}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, off).picks.empty());
+}
+
 TEST(Picking, TheTruthTellsWhetherAnythingCouldBeTaken) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);

@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "cloud_support.hpp"
 #include "mesh_support.hpp"
@@ -265,6 +266,54 @@ TEST(Verify, ContourEdgesAreWhereTheOutlineMeetsAnImageEdge) {
   cv::Mat cut_depth(120, 160, CV_32FC1, cv::Scalar(1.2f));
   cut_depth(cut).setTo(1.0f);
   EXPECT_GT(contourEdgeSupport(face(cut), imageEdges(cut_bgr), cut_depth, camera, 0.01f), 0.95f);
+}
+
+// Picking's outline test (outlineOnEdges): the outline's nearest image edge must lie within
+// 1.5 px of it. A look-alike whose outline meets edges within the contour test's 2 px along its
+// long sides, but strays at its ends, scores low; so does the right outline 3 px off. A
+// stronger edge a few pixels away does not pull a right outline off its own edge.
+TEST(Verify, TheOutlineLiesOnTheImagesEdgesWhenThePoseIsRight) {
+  const Camera camera = smallCamera(160, 120, 150.0);
+  const auto face = [&](const cv::Mat& mask) {
+    PointCloud points;
+    for (int v = 0; v < mask.rows; ++v)
+      for (int u = 0; u < mask.cols; ++u)
+        if (mask.at<uint8_t>(v, u))
+          points.emplace_back(static_cast<float>((u - camera.cx) / camera.fx), static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+    return points;
+  };
+  const auto outlineOf = [&](const cv::Mat& mask, const cv::Mat& depth) {
+    return outlineSamples(face(mask), camera, depth.size());
+  };
+  // The part: a trapezoid 90 px long, 50 px across at one end and 74 at the other (the IC-BIN
+  // cup lying 0.7 m away, 64-92 mm across). The look-alike: a rectangle 62 px across (a
+  // cylinder of its mean width), which meets the part's outline along the middle of its sides.
+  cv::Mat part = cv::Mat::zeros(120, 160, CV_8UC1), cylinder = part.clone();
+  const std::vector<cv::Point> trapezoid = {{35, 35}, {125, 23}, {125, 97}, {35, 85}};
+  cv::fillConvexPoly(part, trapezoid, 255);
+  cv::rectangle(cylinder, cv::Rect(35, 29, 91, 63), 255, cv::FILLED);
+  const auto scene = [&](const cv::Mat& mask) {
+    cv::Mat depth(120, 160, CV_32FC1, cv::Scalar(1.2f)), bgr(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
+    depth.setTo(1.0f, mask);
+    bgr.setTo(cv::Scalar(180, 170, 160), mask);
+    return std::pair{depth, imageEdges(bgr)};
+  };
+  const auto [part_depth, part_edges] = scene(part);
+  const auto [cylinder_depth, cylinder_edges] = scene(cylinder);
+  const auto outline = outlineOf(part, part_depth);
+  EXPECT_GT(outlineOnEdges(outline, part_edges, part_depth, 0.01f), 0.9f) << "the part where it lies";
+  EXPECT_LT(outlineOnEdges(outlineOf(part, cylinder_depth), cylinder_edges, cylinder_depth, 0.01f), 0.7f)
+      << "the part's outline on the cylinder";
+  cv::Mat moved;
+  cv::warpAffine(part, moved, cv::Mat_<double>({2, 3}, {1, 0, 0, 0, 1, 3}), part.size(), cv::INTER_NEAREST);
+  const auto [moved_depth, moved_edges] = scene(moved);
+  EXPECT_LT(outlineOnEdges(outline, moved_edges, moved_depth, 0.01f), 0.5f) << "the part 3 px lower";
+  // White lines 4 px outside the part's long sides: stronger edges, but not the nearest.
+  cv::Mat striped_bgr(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
+  cv::line(striped_bgr, {35, 31}, {125, 19}, cv::Scalar(255, 255, 255), 2);
+  cv::line(striped_bgr, {35, 89}, {125, 101}, cv::Scalar(255, 255, 255), 2);
+  striped_bgr.setTo(cv::Scalar(180, 170, 160), part);
+  EXPECT_GT(outlineOnEdges(outline, imageEdges(striped_bgr), part_depth, 0.01f), 0.9f);
 }
 
 }  // namespace
