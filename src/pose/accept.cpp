@@ -189,6 +189,10 @@ std::string stageEightShortfall(const PoseCandidate& c) {
     return fmt::format("only {:.0f}% of its visible outline meets an edge in the image (at least {:.0f}%): "
                        "something else of its size?",
                        100 * e.contour_edges, 100 * vp.min_contour_edges);
+  if (e.outline_on_edges < vp.min_outline_on_edges)
+    return fmt::format("only {:.0f}% of its visible outline lies on an image edge within 1.5 px (at least {:.0f}%): "
+                       "something else of its size, or a pose off the part?",
+                       100 * e.outline_on_edges, 100 * vp.min_outline_on_edges);
   if (e.scaled_outline_support > e.outline_support + vp.size_probe_margin)
     return fmt::format("its outline fits better 15% larger or smaller ({:.0f}% against {:.0f}% at its own size): "
                        "a look-alike of another size?",

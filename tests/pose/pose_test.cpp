@@ -11,6 +11,7 @@
 #include "hypotheses/hypotheses.hpp"
 #include "match/features.hpp"
 #include "match/matcher.hpp"
+#include "pose/accept.hpp"
 #include "pose/candidate.hpp"
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
@@ -330,6 +331,18 @@ std::vector<TemplateBank> twoTenCentimetreObjects() {
   banks[1].object = "carton";
   for (auto& b : banks) b.diameter = 0.1f;  // centre at the origin
   return banks;
+}
+
+TEST(StageEight, TheOutlineOnEdgesTestIsOffUntilAsked) {
+  PoseCandidate c;
+  measure(c, true);
+  c.evidence.outline_on_edges = 0.4f;
+  EXPECT_EQ(stageEightShortfall(c), "") << "off by default";
+  c.verify.min_outline_on_edges = 0.7f;  // a pile of small turned parts
+  EXPECT_NE(stageEightShortfall(c).find("only 40% of its visible outline lies on an image edge"), std::string::npos)
+      << stageEightShortfall(c);
+  c.evidence.outline_on_edges = 0.8f;
+  EXPECT_EQ(stageEightShortfall(c), "");
 }
 
 TEST(FirstFit, StopsStartsShortOfStageEightsLimitsAndSaysWhy) {
