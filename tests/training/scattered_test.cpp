@@ -70,6 +70,8 @@ TEST(ScatteredSelection, ChoosesAsThePlainLoop) {
 }
 
 TEST(ScatteredSelection, KeepsEveryCandidateWhenThereAreFewerThanAsked) {
+  EXPECT_TRUE(selectScattered({}, 63).empty());
+  EXPECT_EQ(selectScattered({{4, 2, 1, 0.f}}, 63).size(), 1u);
   const std::vector<FeatureCandidate> few = {{1, 1, 0, 2.f}, {5, 1, 1, 3.f}, {9, 9, 2, 3.f}};
   const auto got = selectScattered(few, 63);
   ASSERT_EQ(got.size(), 3u);
