@@ -27,6 +27,34 @@ float depthAt(const cv::Mat& depth_m, float x, float y) {
   if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) return 0.f;
   return depth_m.at<float>(v, u);
 }
+
+/// Whether an outline sample can say anything about the image's edges: no occluder hides it
+/// (the scene inside the outline nearer than the model, or something right outside standing
+/// in front: its edges are the occluder's), and it lies `border` px or more inside the image
+/// (the image's border is no edge of the object's).
+bool edgeSampleUsable(const OutlineSample& sample, const cv::Mat& scene_depth_m, float jump, float border) {
+  const auto& [c, normal, model_z_in] = sample;
+  const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
+  const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+  if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) return false;
+  if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) return false;
+  return c.x() >= border && c.y() >= border && c.x() < float(scene_depth_m.cols) - border &&
+         c.y() < float(scene_depth_m.rows) - border;
+}
+
+/// |gradient . normal| at the pixel nearest q where the gradient is at least sqrt(min_sq) and
+/// within 30 degrees of the normal (either sign: the object may be darker or brighter than
+/// what lies behind it); -1 where it is not (or q is outside the image).
+float gradientAcross(const ImageEdges& edges, const Eigen::Vector2f& q, const Eigen::Vector2f& normal, float min_sq) {
+  static const float cos_max = std::cos(0.5236f);
+  const int u = static_cast<int>(std::lround(q.x())), v = static_cast<int>(std::lround(q.y()));
+  if (u < 0 || v < 0 || u >= edges.dx.cols || v >= edges.dx.rows) return -1.f;
+  const float gx = edges.dx.at<float>(v, u), gy = edges.dy.at<float>(v, u);
+  const float sq = gx * gx + gy * gy;
+  if (sq < min_sq) return -1.f;
+  const float a = std::abs(gx * normal.x() + gy * normal.y());
+  return a >= cos_max * std::sqrt(sq) ? a : -1.f;
+}
 }  // namespace
 
 std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const Camera& camera, cv::Size size) {
@@ -118,32 +146,16 @@ float contourEdgeSupport(const PointCloud& model_points, const ImageEdges& edges
 float contourEdgeSupport(const std::vector<OutlineSample>& outline, const ImageEdges& edges,
                          const cv::Mat& scene_depth_m, float jump, float min_gradient) {
   CV_Assert(edges.dx.type() == CV_32FC1 && edges.dy.type() == CV_32FC1 && edges.dx.size() == scene_depth_m.size());
-  const float cos_max = std::cos(0.5236f);  // 30 degrees between the gradient and the outline's normal
   const float min_sq = min_gradient * min_gradient;
   std::size_t met = 0, usable = 0;
-  for (const auto& [c, normal, model_z_in] : outline) {
-    // An occluder hides the outline where the scene inside it lies nearer than the model, or
-    // where something right outside stands in front: its edges say nothing about the model.
-    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
-    if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) continue;
-    if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) continue;
-    if (!(c.x() >= 2.f && c.y() >= 2.f && c.x() < float(edges.dx.cols - 2) && c.y() < float(edges.dx.rows - 2)))
-      continue;  // the image's border is no edge of the object's
+  for (const OutlineSample& sample : outline) {
+    if (!edgeSampleUsable(sample, scene_depth_m, jump, 2.f)) continue;
     ++usable;
-    for (int t = -2; t <= 2; ++t) {
-      const Eigen::Vector2f q = c + static_cast<float>(t) * normal;
-      const int u = static_cast<int>(std::lround(q.x())), v = static_cast<int>(std::lround(q.y()));
-      if (u < 0 || v < 0 || u >= edges.dx.cols || v >= edges.dx.rows) continue;
-      const float gx = edges.dx.at<float>(v, u), gy = edges.dy.at<float>(v, u);
-      const float sq = gx * gx + gy * gy;
-      if (sq < min_sq) continue;
-      // Either sign: the object may be darker or brighter than what lies behind it.
-      if (std::abs(gx * normal.x() + gy * normal.y()) >= cos_max * std::sqrt(sq)) {
+    for (int t = -2; t <= 2; ++t)
+      if (gradientAcross(edges, sample.at + static_cast<float>(t) * sample.out, sample.out, min_sq) >= 0.f) {
         ++met;
         break;
       }
-    }
   }
   return usable ? static_cast<float>(met) / static_cast<float>(usable) : 0.f;
 }
@@ -152,32 +164,16 @@ float outlineOnEdges(const std::vector<OutlineSample>& outline, const ImageEdges
                      float jump, float min_gradient, float tolerance_px) {
   CV_Assert(edges.dx.type() == CV_32FC1 && edges.dy.type() == CV_32FC1 && edges.dx.size() == scene_depth_m.size());
   constexpr int kReach = 6;  // px each way along the normal
-  const float cos_max = std::cos(0.5236f);
   const float min_sq = min_gradient * min_gradient;
   std::size_t on = 0, usable = 0;
   std::array<float, 2 * kReach + 3> across{};
-  for (const auto& [c, normal, model_z_in] : outline) {
-    // The samples contourEdgeSupport uses: no occluder in front, not at the image's border.
-    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
-    if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) continue;
-    if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) continue;
-    if (!(c.x() >= kReach && c.y() >= kReach && c.x() < float(edges.dx.cols - kReach) &&
-          c.y() < float(edges.dx.rows - kReach)))
-      continue;
+  for (const OutlineSample& sample : outline) {
+    if (!edgeSampleUsable(sample, scene_depth_m, jump, kReach)) continue;
     ++usable;
     // |gradient . normal| at each step along the normal, 0 where it is weak or runs along.
-    across.fill(0.f);
-    for (int t = -kReach - 1; t <= kReach + 1; ++t) {
-      const Eigen::Vector2f q = c + static_cast<float>(t) * normal;
-      const int u = static_cast<int>(std::lround(q.x())), v = static_cast<int>(std::lround(q.y()));
-      if (u < 0 || v < 0 || u >= edges.dx.cols || v >= edges.dx.rows) continue;
-      const float gx = edges.dx.at<float>(v, u), gy = edges.dy.at<float>(v, u);
-      const float sq = gx * gx + gy * gy;
-      if (sq < min_sq) continue;
-      const float a = std::abs(gx * normal.x() + gy * normal.y());
-      if (a >= cos_max * std::sqrt(sq)) across[static_cast<std::size_t>(t + kReach + 1)] = a;
-    }
+    for (int t = -kReach - 1; t <= kReach + 1; ++t)
+      across[static_cast<std::size_t>(t + kReach + 1)] =
+          std::max(0.f, gradientAcross(edges, sample.at + static_cast<float>(t) * sample.out, sample.out, min_sq));
     // The edge nearest the outline (a local maximum across it, looked for from 0 outward): the
     // object's own edge when the pose is right, whatever stronger edges lie a few pixels off.
     // The outline runs along the mask's outermost pixels, half a pixel inside the true edge.
