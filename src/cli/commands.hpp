@@ -8,6 +8,10 @@
 #include "vkpose/detector.hpp"
 #include "vkpose/device.hpp"
 
+namespace vkpose {
+struct PickParams;
+}
+
 namespace vkpose::cli {
 
 /// Exit codes, documented in README.md and docs/reliability.md.
@@ -36,6 +40,9 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global);
 Runner addConfigCommand(CLI::App& app, const GlobalOptions& global);
 /// Adds `--config FILE` (stage parameters, config.hpp) to a command.
 void addConfigOption(CLI::App* sub, std::string& path);
+/// `--pick-order`, `--max-tilt` and `--min-outline-fit`: how picks are planned and ordered
+/// (detect and eval alike); the order is parsed by parsePickOrder when the command runs.
+void addPickFlags(CLI::App* sub, std::string& pick_order, PickParams& pick, const std::string& group);
 /// `--sensor NAME|FILE` (config.hpp's sensorProfile()); `what` says what the sensor sets.
 void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what);
 /// The command-line flag of a stage parameter (`flag` as the parameter table in config_io.cpp

@@ -314,20 +314,7 @@ void addPickingOptions(CLI::App* sub, EvalOptions& o) {
                   "Grasp file of an object: plan each image's picks (the bin from SCENE/bin/IMAGE.json when synth "
                   "wrote it) and check the first against the ground truth; repeat for several objects")
       ->group(picking);
-  sub->add_option("--pick-order", opt->pick_order, "What the pick list is ordered by: combined, height, score, visible")
-      ->check(CLI::IsMember({"combined", "height", "score", "visible"}))
-      ->capture_default_str()
-      ->group(picking);
-  sub->add_option("--max-tilt", opt->pick.max_tilt_deg, "Largest approach tilt from the camera's view, degrees")
-      ->check(CLI::Range(1.0, 180.0))
-      ->capture_default_str()
-      ->group(picking);
-  sub->add_option("--min-outline-fit", opt->pick.min_outline_on_edges,
-                  "A detection is picked only when this share of its outline lies on the image's edges (its "
-                  "outline_on_edges; 0: off)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str()
-      ->group(picking);
+  addPickFlags(sub, opt->pick_order, opt->pick, picking);
 }
 
 /// What counts as a correct estimate, and which instances count.
