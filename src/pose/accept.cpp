@@ -193,10 +193,10 @@ std::string stageEightShortfall(const PoseCandidate& c) {
     return fmt::format("only {:.0f}% of its visible outline lies on an image edge within 1.5 px (at least {:.0f}%): "
                        "something else of its size, or a pose off the part?",
                        100 * e.outline_on_edges, 100 * vp.min_outline_on_edges);
-  if (e.scaled_outline_support > e.outline_support + vp.size_probe_margin)
+  if (e.scaled_outline_support > e.outlineSupport() + vp.size_probe_margin)
     return fmt::format("its outline fits better 15% larger or smaller ({:.0f}% against {:.0f}% at its own size): "
                        "a look-alike of another size?",
-                       100 * e.scaled_outline_support, 100 * e.outline_support);
+                       100 * e.scaled_outline_support, 100 * e.outlineSupport());
   return {};
 }
 

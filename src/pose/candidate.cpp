@@ -403,7 +403,6 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
   const auto outline = outlineSamples(model, frame.camera, frame.depth_m.size());
   e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump);
   e.contour_edges = contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump);
-  e.outline_support = 0.5f * (e.contour_edges + e.silhouette_support);
   e.outline_on_edges = outlineOnEdges(outline, frame.edges, frame.depth_m, params.silhouette_jump);
   if (with_cells) {
     e.explained = supportCells(model, frame.depth_m, frame.camera, params.see_through_tolerance);

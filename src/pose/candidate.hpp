@@ -68,11 +68,13 @@ struct PoseEvidence {
   float silhouette_support = 0.f;
   float contour_edges = 0.f;
   std::vector<int> explained;   ///< the scene cells it explains (supportCells)
-  /// The outline's support (contour edges and silhouette, averaged) at the part's own size, and
-  /// the better of it with the model scaled by 1/1.15 and 1.15 about its centre (measured with
-  /// the scene cells only): a look-alike of another size is explained better by another scale.
-  float outline_support = 0.f, scaled_outline_support = 0.f;
+  /// The better outline support (outlineSupport) of the model scaled by 1/1.15 and 1.15 about
+  /// its centre (measured with the scene cells only): a look-alike of another size is
+  /// explained better by another scale.
+  float scaled_outline_support = 0.f;
   float outline_on_edges = 0.f;  ///< outlineOnEdges: how closely the outline lies on the image's edges
+  /// The outline's support at the part's own size: contour edges and silhouette, averaged.
+  float outlineSupport() const { return 0.5f * (contour_edges + silhouette_support); }
 };
 
 /// One start of stages 6-8 and what each stage found for it.
