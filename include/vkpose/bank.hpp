@@ -3,11 +3,13 @@
 // rendered from a mesh with their LINEMOD features, the pose each was rendered at and the
 // depth/normal crops the cluster score compares; the bank file that stores them, and a cache
 // of banks kept between runs.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,6 +39,15 @@ struct SteppedRange {
 
 /// Parses "A:B:STEP" (or a single value "A"); throws InputError on nonsense.
 SteppedRange parseSteppedRange(const std::string& text, const std::string& what);
+
+/// The camera distances (metres, to the object's centre) a bank trained at `radii` finds an
+/// object at: the nearest and farthest trained distance widened by half a step, at least 5 %
+/// (the depth gate's allowance; LINEMOD matches a view at about the size it was trained at).
+inline std::pair<float, float> coveredDistances(const SteppedRange& radii) {
+  const std::vector<float> r = radii.values();
+  const float half_step = 0.5f * std::max(0.f, radii.step);
+  return {r.front() - std::max(half_step, 0.05f * r.front()), r.back() + std::max(half_step, 0.05f * r.back())};
+}
 
 struct ViewSamplingParams {
   /// Viewpoints on the (hemi)sphere, spread by a Fibonacci lattice. Paper: 216.

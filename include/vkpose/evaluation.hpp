@@ -467,6 +467,14 @@ using EvalProgress = std::function<void(std::size_t, std::size_t)>;
 /// model's (within 10%: a bank of another object or in other units); InputError otherwise.
 void checkBanksAgainstDataset(const std::map<int, TemplateBank>& banks, const BopDataset& dataset);
 
+/// One warning per evaluated object with instances (in images [first, end), at least
+/// `min_visib` visible) whose centre lies nearer or farther from the camera than its bank was
+/// trained at (its radii, widened by half a step or 5 %): LINEMOD matches a view at about the
+/// size it was trained at, so such instances are mostly missed, and a user should see why
+/// before reading the recall. Empty when every instance is covered.
+std::vector<std::string> distanceCoverageWarnings(const std::map<int, TemplateBank>& banks, const BopDataset& dataset,
+                                                  std::size_t first, std::size_t end, float min_visib = 0.f);
+
 /// Runs the methods on the dataset's images and scores them. `banks` maps BOP obj_id to the
 /// object's bank; the evaluated objects are the banks' (ground truth of other objects is left
 /// out). vkpose and linemod need banks; ppf trains on the dataset's models/obj_%06d.ply. With

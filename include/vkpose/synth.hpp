@@ -178,6 +178,9 @@ struct SynthSummary {
   int instances = 0;        ///< ground-truth instances written
   int left_out = 0;         ///< random: instances that found no free place
   double ms_per_image = 0;  ///< rendering, noise and writing, per image
+  /// The ground-truth instances' distances from the camera (their box centres, the point
+  /// training's views look at), metres: what a bank's --radii must cover to find them all.
+  float nearest_m = 0.f, farthest_m = 0.f;
   std::vector<MeshLoadReport> mesh_reports;  ///< per mesh: the unit used and whether it was inferred
 };
 

@@ -2,11 +2,13 @@
 // multi-instance BOP dataset (include/vkpose/synth.hpp does the work).
 #include <charconv>
 #include <cmath>
+#include <string>
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 
 #include "cli/commands.hpp"
 #include "util/progress.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
 #include "vkpose/synth.hpp"
 
@@ -149,6 +151,14 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     fmt::print("wrote {} image{} with {} instances of {} object{} to {} ({:.0f} ms per image on {})\n", s.images,
                s.images == 1 ? "" : "s", s.instances, params.meshes.size(), params.meshes.size() == 1 ? "" : "s",
                opt->out, s.ms_per_image, ctx.device().name);
+    const auto [near_m, far_m] = coveredDistances(ViewSamplingParams{}.radii);
+    if (s.instances > 0)
+      fmt::print("the instances lie {:.2f}-{:.2f} m from the camera{}\n", s.nearest_m, s.farthest_m,
+                 s.nearest_m < near_m || s.farthest_m > far_m
+                     ? fmt::format(": a bank trained at train's default --radii finds them at {:.2f}-{:.2f} m; train "
+                                   "with --radii covering these distances, or set --camera-distance",
+                                   near_m, far_m)
+                     : std::string());
     if (s.left_out > 0)
       fmt::print("{} random instance{} found no free place and {} left out\n", s.left_out,
                  s.left_out == 1 ? "" : "s", s.left_out == 1 ? "was" : "were");

@@ -90,6 +90,40 @@ void checkBanksAgainstDataset(const std::map<int, TemplateBank>& banks, const Bo
   }
 }
 
+std::vector<std::string> distanceCoverageWarnings(const std::map<int, TemplateBank>& banks, const BopDataset& dataset,
+                                                  std::size_t first, std::size_t end, float min_visib) {
+  std::vector<std::string> out;
+  end = std::min(end, dataset.images.size());
+  for (const auto& [obj_id, bank] : banks) {
+    const auto [lo, hi] = coveredDistances(bank.params.views.radii);
+    int instances = 0, nearer = 0, farther = 0;
+    float nearest = 1e9f, farthest = 0.f;
+    for (std::size_t i = first; i < end; ++i) {
+      const BopImage& im = dataset.images[i];
+      for (std::size_t g = 0; g < im.gt.size(); ++g) {
+        const GroundTruthPose& gt = im.gt[g];
+        const float visib = g < im.gt_info.size() ? im.gt_info[g].visib_fract : gt.visib_fract;
+        if (gt.obj_id != obj_id || visib < min_visib) continue;
+        ++instances;
+        const float d = (gt.R * bank.centre + gt.t).norm();
+        if (d < lo) ++nearer, nearest = std::min(nearest, d);
+        if (d > hi) ++farther, farthest = std::max(farthest, d);
+      }
+    }
+    if (nearer + farther == 0) continue;
+    std::string where;
+    if (nearer) where = fmt::format("{} nearer (down to {:.2f} m)", nearer, nearest);
+    if (farther) where += fmt::format("{}{} farther (up to {:.2f} m)", where.empty() ? "" : ", ", farther, farthest);
+    out.push_back(fmt::format(
+        "{} of {} instances of object {} lie outside the distances its bank '{}' was trained at ({:.2f}-{:.2f} m "
+        "from --radii {:g}:{:g}:{:g}): {}; LINEMOD misses most of those, so train with --radii covering the "
+        "scenes' distances",
+        nearer + farther, instances, obj_id, bank.object, lo, hi, bank.params.views.radii.from,
+        bank.params.views.radii.to, bank.params.views.radii.step, where));
+  }
+  return out;
+}
+
 struct Evaluator::State {
   State(GpuContext& c, BopDataset d, const EvalRunParams& p) : ctx(c), dataset(std::move(d)), params(p) {}
   GpuContext& ctx;

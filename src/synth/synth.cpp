@@ -534,6 +534,12 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
     groundTruth(s, image.rendering, frame, gt[i], info[i]);
     cameras[i] = camera;
     summary.instances += static_cast<int>(s.obj_ids.size());
+    for (std::size_t k = 0; k < s.obj_ids.size(); ++k) {
+      const SceneObject& o = s.objects[k];
+      const float d = (o.pose.R * o.mesh->bboxCentre() + o.pose.t).norm();
+      summary.nearest_m = summary.nearest_m > 0.f ? std::min(summary.nearest_m, d) : d;
+      summary.farthest_m = std::max(summary.farthest_m, d);
+    }
     writeImage((scene_dir / "rgb" / fmt::format("{:06d}.png", i)).string(), frame.bgr, false);
     writeImage((scene_dir / "depth" / fmt::format("{:06d}.png", i)).string(), frame.depth_mm, false);
     if (s.bin) {  // where the bin is, for `vkpose detect --bin` (not a BOP file)

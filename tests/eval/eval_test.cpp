@@ -231,6 +231,39 @@ TEST(Evaluation, RefusesBanksTheDatasetHasNoObjectFor) {
             std::string::npos);
 }
 
+TEST(Evaluation, WarnsOfInstancesOutsideTheDistancesTheBankWasTrainedAt) {
+  TemplateBank bank;  // default radii 0.6:1:0.1 m: found at 0.55-1.05 m
+  bank.object = "cup";
+  bank.centre = {0.f, 0.f, 0.05f};
+  EXPECT_FLOAT_EQ(coveredDistances(bank.params.views.radii).first, 0.55f);
+  EXPECT_FLOAT_EQ(coveredDistances(bank.params.views.radii).second, 1.05f);
+  auto at = [](int obj_id, float z, float visib) {
+    GroundTruthPose g;
+    g.obj_id = obj_id;
+    g.t = {0.f, 0.f, z - 0.05f};  // the centre, 5 cm up the object's z, at z
+    g.visib_fract = visib;
+    return g;
+  };
+  BopDataset dataset;
+  dataset.images.resize(3);
+  dataset.images[0].gt = {at(1, 0.5f, 1.f), at(1, 0.8f, 1.f), at(2, 3.f, 1.f)};
+  dataset.images[1].gt = {at(1, 1.2f, 0.9f), at(1, 0.4f, 0.3f)};
+  dataset.images[2].gt = {at(1, 2.f, 1.f)};
+  const std::map<int, TemplateBank> banks{{1, bank}};
+  // Images 0-1, instances at least half visible: 0.5 m and 1.2 m of three lie outside; object 2
+  // has no bank; the 0.4 m one is under the visibility asked for.
+  const std::vector<std::string> w = distanceCoverageWarnings(banks, dataset, 0, 2, 0.5f);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("2 of 3 instances of object 1"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("1 nearer (down to 0.50 m), 1 farther (up to 1.20 m)"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("0.55-1.05 m"), std::string::npos) << w[0];
+  EXPECT_TRUE(distanceCoverageWarnings(banks, dataset, 0, 1, 0.f).size() == 1u);
+  // Every instance inside: no warning; a range past the images is clipped.
+  dataset.images[0].gt = {at(1, 0.6f, 1.f), at(1, 1.f, 1.f)};
+  EXPECT_TRUE(distanceCoverageWarnings(banks, dataset, 0, 1, 0.f).empty());
+  EXPECT_EQ(distanceCoverageWarnings(banks, dataset, 0, 99, 0.f).size(), 1u);  // image 2's 2 m
+}
+
 TEST(Evaluation, ReportsTheThreeMethodsOnTheLmoFrame) {
   VKPOSE_REQUIRE_SHARED_DATA();
   EvalRunParams params;

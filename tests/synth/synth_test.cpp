@@ -116,6 +116,7 @@ TEST(SynthDataset, LoadsAsBopAndEveryPoseProjectsOntoItsBoxes) {
   EXPECT_NEAR(ds.models.at(1).diameter, original.diameter, 1e-5f);
   EXPECT_LT((model.bbox_min - original.bbox_min).norm(), 1e-5f);
   int instances = 0;
+  float nearest = 1e9f, farthest = 0.f;  // of the centres, as the summary reports them
   for (const BopImage& im : ds.images) {
     EXPECT_EQ(im.camera.width, 320);
     EXPECT_EQ(im.camera.depth_scale, 1.0);
@@ -138,10 +139,15 @@ TEST(SynthDataset, LoadsAsBopAndEveryPoseProjectsOntoItsBoxes) {
       const Eigen::Vector3f centre = im.gt[i].R * model.bboxCentre() + im.gt[i].t;
       EXPECT_GT(centre.z(), 0.5f);
       EXPECT_LT(centre.z(), 2.0f);
+      nearest = std::min(nearest, centre.norm());
+      farthest = std::max(farthest, centre.norm());
     }
     EXPECT_GT(cv::countNonZero(depth), depth.total() / 2) << "the table fills the view";
   }
   EXPECT_EQ(instances, s.instances);
+  EXPECT_NEAR(s.nearest_m, nearest, 1e-3f);  // the files hold poses to the micrometre
+  EXPECT_NEAR(s.farthest_m, farthest, 1e-3f);
+  EXPECT_LT(s.nearest_m, s.farthest_m);
   fs::remove_all(dir);
 }
 
