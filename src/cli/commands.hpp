@@ -41,8 +41,10 @@ Runner addConfigCommand(CLI::App& app, const GlobalOptions& global);
 /// Adds `--config FILE` (stage parameters, config.hpp) to a command.
 void addConfigOption(CLI::App* sub, std::string& path);
 /// `--pick-order`, `--max-tilt` and `--min-outline-fit`: how picks are planned and ordered
-/// (detect and eval alike); the order is parsed by parsePickOrder when the command runs.
-void addPickFlags(CLI::App* sub, std::string& pick_order, PickParams& pick, const std::string& group);
+/// (detect and eval alike), each a usage error without `grasps` (`--grasps`), where it would do
+/// nothing; the order is parsed by parsePickOrder when the command runs.
+void addPickFlags(CLI::App* sub, CLI::Option* grasps, std::string& pick_order, PickParams& pick,
+                  const std::string& group);
 /// `--sensor NAME|FILE` (config.hpp's sensorProfile()); `what` says what the sensor sets.
 void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what);
 /// The command-line flag of a stage parameter (`flag` as the parameter table in config_io.cpp

@@ -354,21 +354,25 @@ ExitCode runDetect(const DetectOptions& opt, const GlobalOptions& global) {
 /// The stage parameters `detect` takes as flags (a --config file sets every one).
 }  // namespace
 
-void addPickFlags(CLI::App* sub, std::string& pick_order, PickParams& pick, const std::string& group) {
+void addPickFlags(CLI::App* sub, CLI::Option* grasps, std::string& pick_order, PickParams& pick,
+                  const std::string& group) {
   sub->add_option("--pick-order", pick_order, "What the pick list is ordered by: combined, height, score, visible")
       ->check(CLI::IsMember({"combined", "height", "score", "visible"}))
       ->capture_default_str()
+      ->needs(grasps)
       ->group(group);
   sub->add_option("--max-tilt", pick.max_tilt_deg,
                   "Grasps whose approach is tilted further than this from the approach axis are refused, degrees")
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str()
+      ->needs(grasps)
       ->group(group);
   sub->add_option("--min-outline-fit", pick.min_outline_on_edges,
                   "A detection is picked only when this share of its outline lies on the image's edges (its "
                   "outline_on_edges; 0: off)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str()
+      ->needs(grasps)
       ->group(group);
 }
 
@@ -429,11 +433,12 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--bin", opt->bin, "The bin (JSON: its pose in the camera frame, inner size, wall thickness)")
       ->needs(grasps)
       ->group(picking);
-  addPickFlags(sub, opt->pick_order, opt->pick, picking);
+  addPickFlags(sub, grasps, opt->pick_order, opt->pick, picking);
   sub->add_option("--approach-axis", opt->approach_axis,
                   "The robot's approach direction in the camera frame, 3 numbers (default: down into the --bin, or 0 0 1 along "
                   "the camera's view without one)")
       ->expected(3)
+      ->needs(grasps)
       ->group(picking);
   return [opt, &global]() {
     opt->pick.order = parsePickOrder(opt->pick_order);

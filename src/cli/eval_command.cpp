@@ -314,11 +314,12 @@ void addSpreadOptions(CLI::App* sub, EvalOptions& o) {
 void addPickingOptions(CLI::App* sub, EvalOptions& o) {
   auto* opt = &o;
   auto* picking = "Bin picking (docs/picking.md)";
-  sub->add_option("--grasps", opt->grasps,
-                  "Grasp file of an object: plan each image's picks (the bin from SCENE/bin/IMAGE.json when synth "
-                  "wrote it) and check the first against the ground truth; repeat for several objects")
-      ->group(picking);
-  addPickFlags(sub, opt->pick_order, opt->pick, picking);
+  auto* grasps = sub->add_option("--grasps", opt->grasps,
+                                 "Grasp file of an object: plan each image's picks (the bin from SCENE/bin/IMAGE.json "
+                                 "when synth wrote it) and check the first against the ground truth; repeat for "
+                                 "several objects")
+                     ->group(picking);
+  addPickFlags(sub, grasps, opt->pick_order, opt->pick, picking);
 }
 
 /// What counts as a correct estimate, and which instances count.
