@@ -479,7 +479,8 @@ std::vector<std::string> distanceCoverageWarnings(const std::map<int, TemplateBa
 /// object's bank; the evaluated objects are the banks' (ground truth of other objects is left
 /// out). vkpose and linemod need banks; ppf trains on the dataset's models/obj_%06d.ply. With
 /// only ppf and no banks, every object of the dataset is evaluated. Throws InputError for a
-/// bank the dataset has no object for, a method asked for twice, or nothing to evaluate.
+/// bank the dataset has no object for, a method asked for twice, or nothing to evaluate. The
+/// report's warnings include distanceCoverageWarnings for its images.
 EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::map<int, TemplateBank>& banks,
                          const EvalRunParams& params = {}, const EvalProgress& progress = {});
 

@@ -200,10 +200,6 @@ EvalReport evaluate(const EvalOptions& opt, const GlobalOptions& global, const E
   EvalReport report =
       runEvaluation(ctx, dataset, banks, run, [&](std::size_t done, std::size_t total) { bar.update(done, total); });
   bar.finish();
-  const auto first = static_cast<std::size_t>(std::max(0, run.first_image));
-  const std::size_t end = run.max_images > 0 ? first + static_cast<std::size_t>(run.max_images) : dataset.images.size();
-  for (std::string& w : distanceCoverageWarnings(banks, dataset, first, end, run.eval.min_visib_fract))
-    report.warnings.push_back(std::move(w));
   return report;
 }
 

@@ -295,7 +295,10 @@ EvalReport runEvaluation(GpuContext& ctx, const BopDataset& dataset, const std::
                          const EvalRunParams& params, const EvalProgress& progress) {
   Evaluator evaluator(ctx, dataset, banks, params);
   const auto [begin, end] = evaluator.imageRange();
-  return evaluator.run(begin, end - begin, progress);
+  EvalReport report = evaluator.run(begin, end - begin, progress);
+  for (std::string& w : distanceCoverageWarnings(banks, dataset, begin, end, params.eval.min_visib_fract))
+    report.warnings.push_back(std::move(w));
+  return report;
 }
 
 std::vector<PrPoint> precisionRecallCurve(const std::vector<ScoredOutcome>& outcomes, int instances, int obj_id) {
