@@ -40,13 +40,20 @@ struct SteppedRange {
 /// Parses "A:B:STEP" (or a single value "A"); throws InputError on nonsense.
 SteppedRange parseSteppedRange(const std::string& text, const std::string& what);
 
+/// How much nearer or farther than its training distance `d` a view still matches (LINEMOD
+/// matches a view at about the size it was trained at): half the bank's distance step (0 for
+/// a bank of one distance), at least 5 % of d. The matcher's depth gate and coveredDistances
+/// both use it.
+inline float trainedDistanceAllowance(float distance_step, float d) {
+  return std::max(0.5f * distance_step, 0.05f * d);
+}
+
 /// The camera distances (metres, to the object's centre) a bank trained at `radii` finds an
-/// object at: the nearest and farthest trained distance widened by half a step, at least 5 %
-/// (the depth gate's allowance; LINEMOD matches a view at about the size it was trained at).
+/// object at: the nearest and farthest trained distance widened by trainedDistanceAllowance.
 inline std::pair<float, float> coveredDistances(const SteppedRange& radii) {
   const std::vector<float> r = radii.values();
-  const float half_step = 0.5f * std::max(0.f, radii.step);
-  return {r.front() - std::max(half_step, 0.05f * r.front()), r.back() + std::max(half_step, 0.05f * r.back())};
+  const float step = r.size() > 1 ? radii.step : 0.f;
+  return {r.front() - trainedDistanceAllowance(step, r.front()), r.back() + trainedDistanceAllowance(step, r.back())};
 }
 
 struct ViewSamplingParams {

@@ -100,10 +100,8 @@ std::vector<std::string> distanceCoverageWarnings(const std::map<int, TemplateBa
     float nearest = 1e9f, farthest = 0.f;
     for (std::size_t i = first; i < end; ++i) {
       const BopImage& im = dataset.images[i];
-      for (std::size_t g = 0; g < im.gt.size(); ++g) {
-        const GroundTruthPose& gt = im.gt[g];
-        const float visib = g < im.gt_info.size() ? im.gt_info[g].visib_fract : gt.visib_fract;
-        if (gt.obj_id != obj_id || visib < min_visib) continue;
+      for (const GroundTruthPose& gt : im.gt) {
+        if (gt.obj_id != obj_id || gt.visib_fract < min_visib) continue;  // loadBopDataset copies gt_info's
         ++instances;
         const float d = (gt.R * bank.centre + gt.t).norm();
         if (d < lo) ++nearer, nearest = std::min(nearest, d);

@@ -35,7 +35,7 @@ TemplateDepthGate templateDepthGate(const BankTemplate& t, float diameter_m, flo
   // The surface at the anchor lies within a radius of the centre; a template matches objects
   // up to about half a distance step nearer or further (the next distance's templates take
   // over there), and at least 5 % either way when the bank has one distance.
-  const float tolerance = 0.5f * diameter_m + std::max(0.5f * distance_step_m, 0.05f * t.distance);
+  const float tolerance = 0.5f * diameter_m + trainedDistanceAllowance(distance_step_m, t.distance);
   g.z_lo_mm = std::max(0, static_cast<int>(std::floor((t.distance - tolerance) * 1000.f)));
   g.z_hi_mm = std::min(0xFFFF, static_cast<int>(std::ceil((t.distance + tolerance) * 1000.f)));
   return g;
