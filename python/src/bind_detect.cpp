@@ -605,7 +605,8 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
   m.def(
       "plan_picks",
       [](const PyResult& result, const py::object& grasps, const py::object& depth, const py::object& bin,
-         const std::string& order, float max_tilt, const py::object& approach_axis, float min_outline_on_edges) {
+         const std::string& order, float max_tilt, const py::object& approach_axis, float min_outline_on_edges,
+         float min_colour_agreement) {
         if (!result.frame) valueError("result: a Result of Detector.detect()");
         const auto& banks = result.frame->state->detector->banks();
         PickParams params;
@@ -614,6 +615,9 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
         if (!(min_outline_on_edges >= 0.f && min_outline_on_edges <= 1.f))
           valueError(fmt::format("min_outline_on_edges must be in [0, 1], not {}", min_outline_on_edges));
         params.min_outline_on_edges = min_outline_on_edges;
+        if (!(min_colour_agreement >= 0.f && min_colour_agreement <= 1.f))
+          valueError(fmt::format("min_colour_agreement must be in [0, 1], not {}", min_colour_agreement));
+        params.min_colour_agreement = min_colour_agreement;
         if (!approach_axis.is_none()) params.approach_axis = vector3Of(approach_axis, "approach_axis");
         std::vector<std::string> files;
         if (py::isinstance<py::str>(grasps) || py::hasattr(grasps, "__fspath__")) {
@@ -640,7 +644,7 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
       },
       py::arg("result"), py::arg("grasps"), py::arg("depth"), py::kw_only(), py::arg("bin") = py::none(),
       py::arg("order") = "combined", py::arg("max_tilt") = 45.f, py::arg("approach_axis") = py::none(),
-      py::arg("min_outline_on_edges") = 0.5f,
+      py::arg("min_outline_on_edges") = 0.5f, py::arg("min_colour_agreement") = 0.5f,
       R"(Bin picking on a Result, as `vkpose detect --grasps` does (docs/picking.md): each grasp file's
 grasps placed at the detections of its object, refused where the gripper would hit the bin, the
 scene or another detection, and the detections ordered into a pick list. Returns {"grasps": [per
@@ -651,7 +655,8 @@ grasps: a grasp file or a list of them. depth: the frame's depth (as detect() to
 bin file. order: combined, height, score or visible. max_tilt: degrees from approach_axis
 (default: down into the bin, or the camera's viewing direction (0, 0, 1) without one).
 min_outline_on_edges: a detection is picked only when this share of its outline lies on the
-image's edges (Detection.outline_on_edges; 0: off).)");
+image's edges (Detection.outline_on_edges; 0: off). min_colour_agreement: and only when its colour
+agrees with its model's this much (Detection.colour_agreement, where the mesh has colours; 0: off).)");
 }
 
 }  // namespace vkpose::python

@@ -374,6 +374,13 @@ void addPickFlags(CLI::App* sub, CLI::Option* grasps, std::string& pick_order, P
       ->capture_default_str()
       ->needs(grasps)
       ->group(group);
+  sub->add_option("--min-colour-fit", pick.min_colour_agreement,
+                  "A detection is picked only when its colour agrees with its model's at least this much (its "
+                  "colour_agreement, measured where the mesh has colours; 0: off)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->needs(grasps)
+      ->group(group);
 }
 
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {

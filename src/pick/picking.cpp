@@ -278,6 +278,19 @@ PlacedGrasp placeGrasp(const Grasp& g, const Pose& object_pose, const Eigen::Vec
   return p;
 }
 
+/// Why a detection is not picked at all, whatever its grasps: its outline strays from the
+/// image's edges, or its colour disagrees with its model's; "" when neither.
+std::string poseTooUncertainToPick(const Detection& d, const PickParams& params) {
+  if (d.outline_on_edges < params.min_outline_on_edges)  // false for NaN: not measured
+    return fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %): too "
+                       "uncertain a pose to grip, or something else of its size",
+                       100.f * d.outline_on_edges, 100.f * params.min_outline_on_edges);
+  if (params.min_colour_agreement > 0.f && d.colour_agreement < params.min_colour_agreement)
+    return fmt::format("its colour agrees with the model's {:.2f} (a pick needs {:.2f}): something else of its shape",
+                       d.colour_agreement, params.min_colour_agreement);
+  return {};
+}
+
 float rankOf(const Pick& p, PickOrder order) {
   switch (order) {
     case PickOrder::Height: return p.height;
@@ -416,11 +429,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
     const Detection& d = detections[i];
     const auto b = static_cast<std::size_t>(d.bank);
     if (b >= grasps.size() || grasps[b].empty()) continue;
-    if (d.outline_on_edges < params.min_outline_on_edges) {  // false for NaN: not measured
-      const std::string why =
-          fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %): too "
-                      "uncertain a pose to grip, or something else of its size",
-                      100.f * d.outline_on_edges, 100.f * params.min_outline_on_edges);
+    if (const std::string why = poseTooUncertainToPick(d, params); !why.empty()) {
       std::vector<std::string> names;
       for (const Grasp& g : grasps[b])
         if (std::find(names.begin(), names.end(), g.name) == names.end()) names.push_back(g.name);

@@ -119,6 +119,8 @@ expect "detect: a grasp file with NaN" 1 "$vkpose" -q detect --bank "$dir/cube.v
 expect "detect: --max-tilt without --grasps" 2 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" --max-tilt 30
 expect "detect: --min-outline-fit without --grasps" 2 "$vkpose" -q detect --bank "$dir/cube.vkpb" "${frame[@]}" \
   --min-outline-fit 0.3
+expect "eval: --min-colour-fit without --grasps" 2 "$vkpose" -q eval --dataset "$dir" --bank 1="$dir/cube.vkpb" \
+  --min-colour-fit 0.3
 # Sequences: a folder of frames (rgb/ and depth/) and a list file, one detector for all frames.
 mkdir -p "$dir/seq/rgb" "$dir/seq/depth"
 for n in 000000 000001; do cp "$dir/rgb.png" "$dir/seq/rgb/$n.png"; cp "$dir/depth.png" "$dir/seq/depth/$n.png"; done

@@ -280,6 +280,29 @@ TEST(Picking, APoseWhoseOutlineStraysFromTheImagesEdgesIsNotPicked) {
   EXPECT_FALSE(planPicks({loose}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, off).picks.empty());
 }
 
+TEST(Picking, APoseWhoseColourDisagreesWithItsModelIsNotPicked) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  // A cylinder of another colour taken for the can: its outline fits, its colour does not.
+  Detection other = detectionAt(lyingCan(0.f)), same = other, uncoloured = other;
+  other.outline_on_edges = same.outline_on_edges = 0.9f;
+  other.colour_agreement = 0.3f;
+  same.colour_agreement = 0.85f;  // uncoloured keeps 1: a mesh without colours measures nothing
+  const PickPlan plan = planPicks({other, same, uncoloured}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
+  ASSERT_EQ(plan.detections.size(), 3u);
+  EXPECT_TRUE(plan.detections[0].valid.empty());
+  ASSERT_EQ(plan.detections[0].refused.size(), 1u);
+  EXPECT_NE(plan.detections[0].refused[0].reason.find("colour agrees with the model's 0.30 (a pick needs 0.50)"),
+            std::string::npos)
+      << plan.detections[0].refused[0].reason;
+  EXPECT_FALSE(plan.detections[1].valid.empty());
+  EXPECT_FALSE(plan.detections[2].valid.empty());
+  for (const Pick& p : plan.picks) EXPECT_NE(p.detection, 0);
+  PickParams off;
+  off.min_colour_agreement = 0.f;
+  EXPECT_FALSE(planPicks({other}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, off).picks.empty());
+}
+
 TEST(Picking, TheTruthTellsWhetherAnythingCouldBeTaken) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
