@@ -427,6 +427,7 @@ std::string evalReportJson(const EvalReport& report) {
                     {"split", report.split},
                     {"images", report.images},
                     {"skipped", skipped},
+                    {"warnings", report.warnings},
                     {"device", report.device}};
   return doc.dump(2) + "\n";
 }

@@ -262,6 +262,10 @@ TEST(Evaluation, WarnsOfInstancesOutsideTheDistancesTheBankWasTrainedAt) {
   dataset.images[0].gt = {at(1, 0.6f, 1.f), at(1, 1.f, 1.f)};
   EXPECT_TRUE(distanceCoverageWarnings(banks, dataset, 0, 1, 0.f).empty());
   EXPECT_EQ(distanceCoverageWarnings(banks, dataset, 0, 99, 0.f).size(), 1u);  // image 2's 2 m
+  // The report JSON carries them too, for scripts that read `eval --report`.
+  EvalReport report;
+  report.warnings = w;
+  EXPECT_EQ(nlohmann::json::parse(evalReportJson(report)).at("warnings").get<std::vector<std::string>>(), w);
 }
 
 TEST(Evaluation, ReportsTheThreeMethodsOnTheLmoFrame) {
