@@ -222,6 +222,12 @@ cv::Mat bgrOf(const py::handle& image, const std::string& color, const std::stri
   return m;
 }
 
+/// A share in [0, 1] given from Python, or ValueError naming the argument.
+float shareOf(float value, const char* name) {
+  if (!(value >= 0.f && value <= 1.f)) valueError(fmt::format("{} must be in [0, 1], not {}", name, value));
+  return value;
+}
+
 }  // namespace
 
 DetectorParams paramsOf(const py::handle& config) {
@@ -612,12 +618,8 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
         PickParams params;
         params.order = parsePickOrder(order);
         params.max_tilt_deg = max_tilt;
-        if (!(min_outline_on_edges >= 0.f && min_outline_on_edges <= 1.f))
-          valueError(fmt::format("min_outline_on_edges must be in [0, 1], not {}", min_outline_on_edges));
-        params.min_outline_on_edges = min_outline_on_edges;
-        if (!(min_colour_agreement >= 0.f && min_colour_agreement <= 1.f))
-          valueError(fmt::format("min_colour_agreement must be in [0, 1], not {}", min_colour_agreement));
-        params.min_colour_agreement = min_colour_agreement;
+        params.min_outline_on_edges = shareOf(min_outline_on_edges, "min_outline_on_edges");
+        params.min_colour_agreement = shareOf(min_colour_agreement, "min_colour_agreement");
         if (!approach_axis.is_none()) params.approach_axis = vector3Of(approach_axis, "approach_axis");
         std::vector<std::string> files;
         if (py::isinstance<py::str>(grasps) || py::hasattr(grasps, "__fspath__")) {
@@ -643,8 +645,9 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
         return py::module_::import("json").attr("loads")(json);
       },
       py::arg("result"), py::arg("grasps"), py::arg("depth"), py::kw_only(), py::arg("bin") = py::none(),
-      py::arg("order") = "combined", py::arg("max_tilt") = 45.f, py::arg("approach_axis") = py::none(),
-      py::arg("min_outline_on_edges") = 0.5f, py::arg("min_colour_agreement") = 0.5f,
+      py::arg("order") = "combined", py::arg("max_tilt") = PickParams{}.max_tilt_deg,
+      py::arg("approach_axis") = py::none(), py::arg("min_outline_on_edges") = PickParams{}.min_outline_on_edges,
+      py::arg("min_colour_agreement") = PickParams{}.min_colour_agreement,
       R"(Bin picking on a Result, as `vkpose detect --grasps` does (docs/picking.md): each grasp file's
 grasps placed at the detections of its object, refused where the gripper would hit the bin, the
 scene or another detection, and the detections ordered into a pick list. Returns {"grasps": [per
