@@ -109,8 +109,10 @@ std::vector<BenchFrame> syntheticFrames(const GpuContext& ctx, const std::vector
     near = std::min(near, b.params.views.radii.from);
     far = std::max(far, b.params.views.radii.to);
   }
-  p.camera_range.min_height_m = near;
-  p.camera_range.max_height_m = std::max(near, far);
+  CameraRange camera;
+  camera.min_height_m = near;
+  camera.max_height_m = std::max(near, far);
+  p.camera_range = camera;
   std::vector<Mesh> meshes;
   for (const auto& b : banks) {
     if (b.mesh.vertices.empty()) throw InputError("bank '" + b.object + "' carries no mesh: retrain it (bank version 2)");

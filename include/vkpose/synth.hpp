@@ -76,7 +76,8 @@ struct PlacementParams {
 };
 
 /// Where the camera may be: height of its centre above the table and tilt of its optical axis
-/// from the vertical (a camera over a workcell: 0.6 to 1.2 m, tilted up to 35 degrees).
+/// from the vertical (a camera over a workcell: 0.6 to 1.2 m, tilted up to 35 degrees, the
+/// table layout's camera).
 struct CameraRange {
   float min_height_m = 0.6f, max_height_m = 1.2f;
   /// When max_distance_m > 0, the camera's distance along its optical axis to the point it
@@ -87,6 +88,19 @@ struct CameraRange {
   float max_roll_deg = 10.f;  ///< turn about the optical axis either way
   float target_jitter_m = 0.05f;  ///< the point looked at is this far from the origin at most
 };
+
+/// `synth --camera-distance FROM:TO`: the table camera's tilts and roll, with its distance along
+/// the optical axis to the point it looks at drawn from [near_m, far_m] (metres) instead of its
+/// height: the same draws as before the bin layout had a camera of its own, so such datasets come
+/// out as they did.
+CameraRange cameraAtDistances(float near_m, float far_m);
+
+/// The bin layout's camera: a bin-picking cell's, mounted over the bin and looking down at it
+/// (tilted up to 15 degrees), 0.75 to 0.95 m from the bin floor's centre, so that the parts in
+/// the bin lie within the distances a bank trained at train's default --radii finds (its
+/// 0.55-1.05 m). The table layout's camera, tilted up to 35 degrees and up to 1.2 m high,
+/// sees a bin's far parts from 1.1-1.35 m and its near ones over the walls from 0.45 m.
+CameraRange binCellCamera();
 
 // ---- datasets -------------------------------------------------------------------------
 
@@ -123,7 +137,9 @@ struct SynthParams {
   /// Bin layout: shrink the bin (inside and walls) to the parts and to what the camera sees
   /// from its nearest distance (fitBinToParts); off: placement's sizes as they are.
   bool fit_bin_to_parts = true;
-  CameraRange camera_range;                 ///< random: where the camera may be
+  /// Random: where the camera may be; unset: the layout's own (CameraRange's defaults over a
+  /// table, binCellCamera() over a bin). cameraRangeOf() says which.
+  std::optional<CameraRange> camera_range;
   /// The parts (not the clutter, bin or table) are bare metal: grey, dim in diffuse light,
   /// with bright highlights from the light and from a lamp beside the lens, and, with a
   /// sensor that has them (closeRangeNoise), specular holes in their depth.
@@ -158,6 +174,9 @@ int scaledCopiesReported(const std::vector<ScaledCopy>& copies, const std::vecto
 /// clutter out of range, a --symmetric obj_id without a mesh, poses neither "random" nor a
 /// folder, the bin layout with pose files, a bad camera). Files are checked when read.
 void validateSynthParams(const SynthParams& params);
+
+/// Where `params`' random camera may be: its camera_range, or its layout's own when unset.
+CameraRange cameraRangeOf(const SynthParams& params);
 
 /// A bin for parts of `diameter` metres (the largest) seen by `camera` from no nearer than
 /// `range` allows: at most `placement`'s size, at least four parts across, and filling about 70 %

@@ -84,8 +84,7 @@ std::vector<float> metresOf(const py::handle& value, const std::string& what, st
 void applyCloseRange(SynthParams& params, const py::object& camera_distance, const py::object& bin_size) {
   if (!camera_distance.is_none()) {
     const auto d = metresOf(camera_distance, "camera_distance", 2, 2);
-    params.camera_range.min_distance_m = d[0];
-    params.camera_range.max_distance_m = d[1];
+    params.camera_range = cameraAtDistances(d[0], d[1]);
     if (!(d[1] > 0.f)) valueError("camera_distance: the largest distance must be positive");
   }
   if (!bin_size.is_none()) {

@@ -95,7 +95,9 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--camera-distance", opt->camera_distance,
                   "random: the camera's distance to the point it looks at, FROM:TO metres (e.g. 0.3:0.45 for small "
-                  "parts); default: its height above the table, 0.6 to 1.2 m");
+                  "parts), tilted up to 35 degrees; default: on a table, its height above it, 0.6 to 1.2 m, tilted "
+                  "up to 35 degrees; over a bin, a bin-picking cell's camera 0.75 to 0.95 m from the bin's floor, "
+                  "tilted up to 15 degrees, within the distances train's default --radii covers");
   sub->add_option("--bin-size", opt->bin_size,
                   "bin layout: inside X:Y (metres) and optionally the wall height X:Y:H; default: 0.40:0.30:0.15, "
                   "made smaller for small parts seen from close by");
@@ -125,8 +127,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
     if (!opt->sensor.empty()) params.noise = synthNoise(opt->sensor);
     if (!opt->camera_distance.empty()) {
       const auto d = parseMetres(opt->camera_distance, "--camera-distance", 2, 2);
-      params.camera_range.min_distance_m = d[0];
-      params.camera_range.max_distance_m = d[1];
+      params.camera_range = cameraAtDistances(d[0], d[1]);
     }
     if (!opt->bin_size.empty()) {
       const auto b = parseMetres(opt->bin_size, "--bin-size", 2, 3);

@@ -65,10 +65,12 @@ SynthParams binScenes(const DemoParams& params, const std::vector<std::string>& 
   s.placement.bin_max_tilt_deg = 6.f;
   s.placement.bin_inner_m = {0.46f, 0.36f};
   s.fit_bin_to_parts = false;  // the demo's own bin
-  s.camera_range.min_height_m = 0.75f;
-  s.camera_range.max_height_m = 0.85f;
-  s.camera_range.max_tilt_deg = 12.f;
-  s.camera_range.target_jitter_m = 0.03f;
+  CameraRange camera;
+  camera.min_height_m = 0.75f;
+  camera.max_height_m = 0.85f;
+  camera.max_tilt_deg = 12.f;
+  camera.target_jitter_m = 0.03f;
+  s.camera_range = camera;
   return s;
 }
 

@@ -206,8 +206,8 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
   for (const Mesh& m : models) diameter = std::max(diameter, m.diameter);
   PlacementParams placement = p.placement;
   if (p.placement.layout == Layout::Bin && p.fit_bin_to_parts)
-    placement = fitBinToParts(p.placement, diameter, p.camera, p.camera_range);
-  s.camera_T_world = randomCamera(p.camera_range, rng);
+    placement = fitBinToParts(p.placement, diameter, p.camera, cameraRangeOf(p));
+  s.camera_T_world = randomCamera(cameraRangeOf(p), rng);
   std::vector<OrientedBox> obstacles;
   if (placement.layout == Layout::Bin) obstacles = binWalls(placement);
   std::vector<int> order;  // model indices, shuffled so no object is always placed first
@@ -257,7 +257,7 @@ ImageScene tejaniScene(const SynthParams& p, const Mesh& model, int obj_id, cons
                        std::mt19937& rng) {
   ImageScene s;
   std::vector<const Mesh*> meshes(camera_T_object.size(), &model);
-  s.camera_T_world = camera_T_object.empty() ? randomCamera(p.camera_range, rng) : supportFrame(meshes, camera_T_object);
+  s.camera_T_world = camera_T_object.empty() ? randomCamera(cameraRangeOf(p), rng) : supportFrame(meshes, camera_T_object);
   const Pose world_T_camera = invert(s.camera_T_world);
   std::vector<OrientedBox> obstacles;
   for (const Pose& pose : camera_T_object) {
@@ -391,6 +391,24 @@ RenderedImage renderImage(const GpuContext& ctx, const SynthParams& p, const std
 
 }  // namespace
 
+CameraRange cameraAtDistances(float near_m, float far_m) {
+  CameraRange r;
+  r.min_distance_m = near_m;
+  r.max_distance_m = far_m;
+  return r;
+}
+
+CameraRange binCellCamera() {
+  CameraRange r = cameraAtDistances(0.75f, 0.95f);
+  r.max_tilt_deg = 15.f;
+  return r;
+}
+
+CameraRange cameraRangeOf(const SynthParams& params) {
+  if (params.camera_range) return *params.camera_range;
+  return params.placement.layout == Layout::Bin ? binCellCamera() : CameraRange{};
+}
+
 PlacementParams fitBinToParts(const PlacementParams& placement, float diameter, const Camera& camera,
                               const CameraRange& range) {
   const float nearest = range.max_distance_m > 0.f ? range.min_distance_m : range.min_height_m;
@@ -431,7 +449,7 @@ void validateSynthParams(const SynthParams& p) {
       throw InputError("the bin layout places objects itself: use it with --poses random");
   }
   validateCamera(p.camera, "synth camera");
-  const CameraRange& c = p.camera_range;
+  const CameraRange c = cameraRangeOf(p);
   if (c.max_distance_m > 0.f && !(c.min_distance_m >= 0.1f && c.min_distance_m <= c.max_distance_m &&
                                   c.max_distance_m <= 5.f))
     throw InputError(fmt::format("camera distance {}:{} m: need 0.1 <= FROM <= TO <= 5", c.min_distance_m,

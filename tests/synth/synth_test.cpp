@@ -427,6 +427,43 @@ TEST(SynthCloseRange, TheCameraDistanceIsAlongTheOpticalAxis) {
   EXPECT_LE(height, heights.max_height_m + 1e-4f);
 }
 
+TEST(SynthPlacement, ABinsOwnCameraSeesItsPartsWhereADefaultBankFindsThem) {
+  // A user trains with the default --radii and makes bins with synth's defaults: every part in
+  // those bins lies within the distances that bank finds (issue 52: a tilted table camera put
+  // a third of the missed cups outside them).
+  SynthParams params;
+  params.meshes = {"unused"};
+  params.images = 1;
+  params.min_instances = params.max_instances = 8;
+  params.placement.layout = Layout::Bin;
+  EXPECT_EQ(cameraRangeOf(params).max_tilt_deg, binCellCamera().max_tilt_deg);
+  EXPECT_EQ(cameraRangeOf(params).min_distance_m, binCellCamera().min_distance_m);
+  Mesh cup = test::lShapeMesh();  // a part of a coffee cup's size, 12 cm across
+  const float scale = 0.12f / cup.diameter;
+  for (auto& v : cup.vertices) v *= scale;
+  finishMesh(cup);
+  const auto [near_m, far_m] = coveredDistances(ViewSamplingParams{}.radii);
+  std::size_t parts = 0;
+  for (uint32_t seed = 1; seed <= 4; ++seed) {
+    params.seed = seed;
+    const SynthImage image = synthesizeImage(test::context(), params, {cup}, 0);
+    for (const Pose& pose : image.poses) {
+      EXPECT_GE(pose.t.norm(), near_m) << "seed " << seed;
+      EXPECT_LE(pose.t.norm(), far_m) << "seed " << seed;
+    }
+    parts += image.poses.size();
+  }
+  EXPECT_GE(parts, 16u) << "the bins hold parts";
+  // A table keeps the workcell camera; a range given keeps what it says.
+  params.placement.layout = Layout::Table;
+  EXPECT_EQ(cameraRangeOf(params).max_tilt_deg, CameraRange{}.max_tilt_deg);
+  EXPECT_EQ(cameraRangeOf(params).max_distance_m, 0.f) << "drawn by height";
+  params.placement.layout = Layout::Bin;
+  params.camera_range = cameraAtDistances(0.3f, 0.45f);
+  EXPECT_EQ(cameraRangeOf(params).max_distance_m, 0.45f);
+  EXPECT_EQ(cameraRangeOf(params).max_tilt_deg, CameraRange{}.max_tilt_deg) << "as such datasets were made before";
+}
+
 TEST(SynthCloseRange, BinsFitSmallPartsAndLeaveLargeOnesAlone) {
   const Camera camera = tejaniCamera();
   PlacementParams bin;
@@ -454,8 +491,7 @@ TEST(SynthCloseRange, SmallPartsInABinSeenFromClose) {
   params.seed = 11;
   params.min_instances = params.max_instances = 6;
   params.placement.layout = Layout::Bin;
-  params.camera_range.min_distance_m = 0.3f;
-  params.camera_range.max_distance_m = 0.45f;
+  params.camera_range = cameraAtDistances(0.3f, 0.45f);
   Mesh part = test::lShapeMesh();  // scaled to a 40 mm part
   const float scale = 0.04f / part.diameter;
   for (auto& v : part.vertices) v *= scale;
@@ -475,9 +511,9 @@ TEST(SynthCloseRange, SmallPartsInABinSeenFromClose) {
   cv::minMaxLoc(image.frame.depth_mm, &lo, &hi, nullptr, nullptr, image.frame.depth_mm > 0);
   EXPECT_GT(lo, 100);
   EXPECT_LT(hi, 800);
-  params.camera_range.min_distance_m = 0.05f;
+  params.camera_range->min_distance_m = 0.05f;
   EXPECT_THROW(validateSynthParams(params), InputError);
-  params.camera_range.min_distance_m = 0.3f;
+  params.camera_range->min_distance_m = 0.3f;
   params.placement.bin_inner_m = {0.f, 0.3f};
   EXPECT_THROW(validateSynthParams(params), InputError);
 }
