@@ -96,7 +96,7 @@ struct CameraRange {
 CameraRange cameraAtDistances(float near_m, float far_m);
 
 /// The bin layout's camera: a bin-picking cell's, mounted over the bin and looking down at it
-/// (tilted up to 15 degrees), 0.75 to 0.95 m from the bin floor's centre, so that the parts in
+/// (tilted up to 15 degrees), 0.8 to 1.0 m from the bin floor's centre, so that the parts in
 /// the bin lie within the distances a bank trained at train's default --radii finds (its
 /// 0.55-1.05 m). The table layout's camera, tilted up to 35 degrees and up to 1.2 m high,
 /// sees a bin's far parts from 1.1-1.35 m and its near ones over the walls from 0.45 m.

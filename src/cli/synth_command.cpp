@@ -96,7 +96,7 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_option("--camera-distance", opt->camera_distance,
                   "random: the camera's distance to the point it looks at, FROM:TO metres (e.g. 0.3:0.45 for small "
                   "parts), tilted up to 35 degrees; default: on a table, its height above it, 0.6 to 1.2 m, tilted "
-                  "up to 35 degrees; over a bin, a bin-picking cell's camera 0.75 to 0.95 m from the bin's floor, "
+                  "up to 35 degrees; over a bin, a bin-picking cell's camera 0.8 to 1.0 m from the bin's floor, "
                   "tilted up to 15 degrees, within the distances train's default --radii covers");
   sub->add_option("--bin-size", opt->bin_size,
                   "bin layout: inside X:Y (metres) and optionally the wall height X:Y:H; default: 0.40:0.30:0.15, "

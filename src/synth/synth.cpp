@@ -399,7 +399,7 @@ CameraRange cameraAtDistances(float near_m, float far_m) {
 }
 
 CameraRange binCellCamera() {
-  CameraRange r = cameraAtDistances(0.75f, 0.95f);
+  CameraRange r = cameraAtDistances(0.8f, 1.0f);
   r.max_tilt_deg = 15.f;
   return r;
 }
