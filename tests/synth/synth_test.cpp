@@ -429,8 +429,8 @@ TEST(SynthCloseRange, TheCameraDistanceIsAlongTheOpticalAxis) {
 
 TEST(SynthPlacement, ABinsOwnCameraSeesItsPartsWhereADefaultBankFindsThem) {
   // A user trains with the default --radii and makes bins with synth's defaults: every part in
-  // those bins lies within the distances that bank finds (issue 52: a tilted table camera put
-  // a third of the missed cups outside them).
+  // those bins lies within the distances that bank finds (issue 52: with the table's tilted
+  // camera over the bins, half of the cups left unpicked lay outside them).
   SynthParams params;
   params.meshes = {"unused"};
   params.images = 1;
