@@ -205,9 +205,10 @@ ImageScene randomScene(const SynthParams& p, const std::vector<Mesh>& models, st
   float diameter = 0.f;  // of the largest part
   for (const Mesh& m : models) diameter = std::max(diameter, m.diameter);
   PlacementParams placement = p.placement;
+  const CameraRange camera_range = cameraRangeOf(p);
   if (p.placement.layout == Layout::Bin && p.fit_bin_to_parts)
-    placement = fitBinToParts(p.placement, diameter, p.camera, cameraRangeOf(p));
-  s.camera_T_world = randomCamera(cameraRangeOf(p), rng);
+    placement = fitBinToParts(p.placement, diameter, p.camera, camera_range);
+  s.camera_T_world = randomCamera(camera_range, rng);
   std::vector<OrientedBox> obstacles;
   if (placement.layout == Layout::Bin) obstacles = binWalls(placement);
   std::vector<int> order;  // model indices, shuffled so no object is always placed first
