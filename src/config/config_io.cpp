@@ -112,6 +112,8 @@ std::vector<ConfigField> verifyFields(DetectorParams& p) {
   return {
       {"verify", "resolution", "octree leaf size, metres", &p.verify.resolution, aboveUpTo(0, 0.1), "--octree-resolution"},
       {"verify", "threshold", "collision rate phi a pose needs, 0..1", &p.verify.threshold, closed(0, 1), "--min-collision"},
+      {"verify", "occlusion_credit",
+       "phi counts over the model points the scene does not hide, at most this share of them hidden, 0..1 (0: off)", &p.verify.occlusion_credit, closed(0, 1)},
       {"verify", "crop_margin", "scene points within the model's box grown by this go in the octree, metres", &p.verify.crop_margin, atLeast(0)},
       {"verify", "see_through_tolerance", "scene depth this far behind the model sees through it, metres", &p.verify.see_through_tolerance, atLeast(0)},
       {"verify", "max_see_through", "largest share of model points the scene may see through, 0..1", &p.verify.max_see_through, closed(0, 1)},

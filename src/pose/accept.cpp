@@ -143,7 +143,19 @@ float poseScore(const PoseEvidence& e) {
   return poseScore(e.collision.collision_rate, e.depth.seen_through, e.silhouette_support);
 }
 
-bool collides(const PoseCandidate& c) { return c.measured && c.evidence.collision.accepted; }
+float unhiddenCollisionRate(const PoseEvidence& e, const VerifyParams& vp) {
+  const float unhidden = std::max(1.f - e.depth.occluded, 1.f - vp.occlusion_credit);
+  return unhidden > 0.f ? e.collision.collision_rate / unhidden : e.collision.collision_rate;
+}
+
+namespace {
+/// Stage 8's collision test (VerifyResult::accepted with the hidden points left out).
+bool collisionAccepted(const PoseEvidence& e, const VerifyParams& vp) {
+  return e.collision.model_points > 0 && unhiddenCollisionRate(e, vp) > vp.threshold;
+}
+}  // namespace
+
+bool collides(const PoseCandidate& c) { return c.measured && collisionAccepted(c.evidence, c.verify); }
 
 bool hopeless(const PoseCandidate& c) {
   return c.evidence.silhouette_support < c.verify.hopeless_support_share * c.verify.min_silhouette_support;
@@ -177,8 +189,9 @@ std::string stageEightShortfall(const PoseCandidate& c) {
   const VerifyParams& vp = c.verify;
   const PoseEvidence& e = c.evidence;
   const float see_through = e.depth.seen_through;
-  if (!e.collision.accepted)
-    return fmt::format("collision rate {:.2f} is not above {:.2f}", e.collision.collision_rate, vp.threshold);
+  if (!collisionAccepted(e, vp))
+    return fmt::format("collision rate {:.2f} ({:.2f} of the points the scene does not hide) is not above {:.2f}",
+                       e.collision.collision_rate, unhiddenCollisionRate(e, vp), vp.threshold);
   if (see_through > vp.max_see_through)
     return fmt::format("the camera sees through {:.0f}% of the model (at most {:.0f}%)", 100 * see_through,
                        100 * vp.max_see_through);

@@ -27,6 +27,10 @@ bool samePose(const Pose& a, const Pose& b, const TemplateBank& bank, float dist
 float poseScore(float collision_rate, float see_through, float silhouette_support);
 float poseScore(const PoseEvidence& evidence);
 
+/// The collision rate stage 8 tests: counted over the model points the scene does not hide,
+/// with at most VerifyParams::occlusion_credit of them hidden.
+float unhiddenCollisionRate(const PoseEvidence& evidence, const VerifyParams& params);
+
 /// Passed the collision test: the candidate that the later checks (alternatives) consider.
 bool collides(const PoseCandidate& c);
 

@@ -232,10 +232,11 @@ std::string firstFitShortfall(const PoseCandidate& c) {
   const RefineParams& rp = c.refine;
   const VerifyParams& vp = c.verify;
   const float share = rp.first_fit_share;
-  const float collision = e.collision.collision_rate;
+  const float collision = unhiddenCollisionRate(e, vp);
   if (collision < c.first_fit_min_collision)
-    return fmt::format("collision rate {:.2f} after the first fit (at least {:.2f} to go on)", collision,
-                       c.first_fit_min_collision);
+    return fmt::format("collision rate {:.2f} of the points the scene does not hide after the first fit (at least "
+                       "{:.2f} to go on)",
+                       collision, c.first_fit_min_collision);
   if (e.contour_edges < rp.first_fit_contour_share * vp.min_contour_edges)
     return fmt::format("only {:.0f}% of its visible outline meets an edge in the image after the first fit (at "
                        "least {:.0f}% to go on)",
