@@ -157,8 +157,8 @@ Runner addSynthCommand(CLI::App& app, const GlobalOptions& global) {
       fmt::print("the instances lie {:.2f}-{:.2f} m from the camera{}\n", s.nearest_m, s.farthest_m,
                  s.nearest_m < near_m || s.farthest_m > far_m
                      ? fmt::format(": a bank trained at train's default --radii finds them at {:.2f}-{:.2f} m; train "
-                                   "with --radii covering these distances, or set --camera-distance",
-                                   near_m, far_m)
+                                   "with --radii covering these distances{}",
+                                   near_m, far_m, opt->camera_distance.empty() ? ", or set --camera-distance" : "")
                      : std::string());
     if (s.left_out > 0)
       fmt::print("{} random instance{} found no free place and {} left out\n", s.left_out,
