@@ -17,7 +17,9 @@ struct VerifyResult {
   float collision_rate = 0;  ///< phi = hits / model_points, 0 when there are no model points
   std::size_t model_points = 0, hits = 0;  ///< finite model points; those in occupied cells
   std::size_t scene_points = 0;            ///< scene points inserted (after the crop)
-  bool accepted = false;                   ///< collision_rate > threshold
+  /// collision_rate > threshold, the paper's test; stage 8 leaves out the points the scene
+  /// hides (unhiddenCollisionRate, pose/accept.hpp).
+  bool accepted = false;
   double ms = 0;
 };
 
