@@ -253,9 +253,10 @@ struct VerifyParams {
   /// compare hits / (points x max(1 - occluded, 1 - occlusion_credit)) with the threshold,
   /// where `occluded` is the share of points the scene lies in front of (DepthAgreement); the
   /// credit caps how much of the part may be hidden (a pose sunk into a surface also looks
-  /// hidden). The reported collision_rate and the score stay hits / points. LM-O frame: the
-  /// glue found (5 -> 6 of 8, none wrong); cup bins 5151: 25 -> 28 found; the stress, lying
-  /// and bracket sets unchanged (docs/history.md). 0: the paper's rate.
+  /// hidden). The reported collision_rate and the score stay hits / points. LM-O frame, banks
+  /// trained `--units mm` alone: the glue found (4 -> 5 of 8, none wrong); cup bins 5151:
+  /// 25 -> 28 found; the stress, lying and bracket sets unchanged (docs/history.md). 0: the
+  /// paper's rate.
   float occlusion_credit = 0.5f;
   float crop_margin = 0.02f;  ///< scene points within the model's box grown by this (metres) go in the octree
   /// Free-space test: a visible model point whose pixel sees the scene this much (metres)
