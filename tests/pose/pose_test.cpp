@@ -319,7 +319,6 @@ PoseCandidate firstFitStart(int bank, const Eigen::Vector3f& t, float collision,
 /// Stage 8's measurements, passing every test or failing the collision test.
 void measure(PoseCandidate& c, bool passes) {
   c.measured = true;
-  c.evidence.collision.accepted = passes;
   c.evidence.collision.model_points = 1000;
   c.evidence.collision.collision_rate = passes ? 0.8f : 0.2f;
   c.evidence.silhouette_support = 1.f;
@@ -384,7 +383,9 @@ TEST(FirstFit, StopsStartsShortOfStageEightsLimitsAndSaysWhy) {
   unplaced.initial.ok = false;
   c.push_back(unplaced);
   screenStarts(c);
-  EXPECT_NE(c[0].screened.find("collision rate 0.28 of the points the scene does not hide after the first fit"), std::string::npos) << c[0].screened;
+  EXPECT_NE(c[0].screened.find("collision rate 0.28 of the points the scene does not hide after the first fit"),
+            std::string::npos)
+      << c[0].screened;
   EXPECT_NE(c[1].screened.find("40% of the outline"), std::string::npos) << c[1].screened;
   EXPECT_NE(c[2].screened.find("sees through 25%"), std::string::npos) << c[2].screened;
   EXPECT_TRUE(c[3].refinable()) << c[3].screened;
