@@ -103,6 +103,22 @@ void checkColourOnly() {
     std::printf("  obj %d: kept, proj2d %.1f px\n", id, e);
     within += e < 5.f;
   }
+  // Issue 50: nothing wrong at score 0.5 or more. And the colour test (colour_only.
+  // min_colour_agreement 0.2) keeps the wrong poses few: 16 today, 33 without it.
+  int wrong = 0;
+  for (const Detection& d : result.detections) {
+    const int id = objectId(d.object);
+    float e = 1e9f;
+    for (const GroundTruthPose& gt : image.gt)
+      if (gt.obj_id == id)
+        e = std::min(e, poseError(models.at(id), {id, d.score, d.pose.R, d.pose.t}, gt, PoseErrorType::Proj2D,
+                                  &image.camera));
+    wrong += e >= 5.f;
+    if (d.score >= 0.5f) {
+      EXPECT_LT(e, 5.f) << d.object << " at score " << d.score << " is " << e << " px off";
+    }
+  }
+  EXPECT_LE(wrong, 20);
   // The can (5), cat (6) and duck (9) are found within 5 px and kept. The goal is 5 of the 8
   // (issue 50); the driller, glue and holepuncher get no start close enough to fit from yet.
   for (int id : {5, 6, 9}) {
