@@ -387,8 +387,10 @@ float scaledOutlineSupport(const PointCloud& model, const PoseFrame& frame, cons
       PointCloud scaled(model.size());
       for (std::size_t i = 0; i < model.size(); ++i) scaled[i] = centre + d + s * (model[i] - centre);
       const auto outline = outlineSamples(scaled, frame.camera, frame.depth_m.size());
-      best = std::max(best, 0.5f * (contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump) +
-                                    silhouetteSupport(outline, frame.depth_m, params.silhouette_jump)));
+      const float silhouette =
+          silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit);
+      best = std::max(
+          best, 0.5f * (contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump) + silhouette));
     }
   }
   return best;
@@ -402,7 +404,7 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
   e.collision = verifyPose(model, scene_points, params);
   e.depth = depthAgreement(model, frame.depth_m, frame.camera, params.see_through_tolerance);
   const auto outline = outlineSamples(model, frame.camera, frame.depth_m.size());
-  e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump);
+  e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit);
   e.contour_edges = contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump);
   e.outline_on_edges = outlineOnEdges(outline, frame.edges, frame.depth_m, params.silhouette_jump);
   if (with_cells) {

@@ -108,21 +108,32 @@ std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const 
 }
 
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
-                        float jump) {
-  return silhouetteSupport(outlineSamples(model_points, camera, scene_depth_m.size()), scene_depth_m, jump);
+                        float jump, float occlusion_credit) {
+  return silhouetteSupport(outlineSamples(model_points, camera, scene_depth_m.size()), scene_depth_m, jump,
+                           occlusion_credit);
 }
 
-float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump) {
+float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump,
+                        float occlusion_credit) {
   CV_Assert(scene_depth_m.type() == CV_32FC1);
-  std::size_t steps = 0, usable = 0;
+  std::size_t steps = 0, usable = 0, hidden = 0;
   for (const auto& [c, normal, model_z_in] : outline) {
     const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
     const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
     if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
     ++usable;
+    // Behind something nearer (the scene inside the outline lies in front of the model): no
+    // step to see there, whether the pose is right or not.
+    if (occlusion_credit > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) {
+      ++hidden;
+      continue;
+    }
     steps += z_out >= z_in + jump;
   }
-  return usable ? static_cast<float>(steps) / static_cast<float>(usable) : 0.f;
+  if (!usable) return 0.f;
+  const float hidden_share = static_cast<float>(hidden) / static_cast<float>(usable);
+  const float counted = std::max(1.f - hidden_share, 1.f - occlusion_credit);
+  return static_cast<float>(steps) / (static_cast<float>(usable) * counted);
 }
 
 ImageEdges imageEdges(const cv::Mat& bgr) {

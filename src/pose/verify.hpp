@@ -58,8 +58,13 @@ std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const 
 /// scene depth 3 px inside and 4 px outside along the outline's normal. Samples where either
 /// has no depth or the outside is nearer (an occluder) are left out; the share is of the rest
 /// whose outside lies at least `jump` farther. 0 when no sample is usable.
-float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera, float jump);
-float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump);
+/// With `occlusion_credit` (VerifyParams::occlusion_credit) the samples where the scene inside
+/// lies `jump` in front of the model (hidden) are left out of the count too, as far as that
+/// share: steps / (usable x max(1 - hidden share, 1 - credit)), as the collision rate counts.
+float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera, float jump,
+                        float occlusion_credit = 0.f);
+float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump,
+                        float occlusion_credit = 0.f);
 
 /// The scene image's intensity gradients (Sobel of the lightly blurred grey image), computed
 /// once a frame for contourEdgeSupport.

@@ -99,16 +99,23 @@ TEST(DetectIcbin, VerifiedPosesSitOnTheCupsTheHypothesesFound) {
   VKPOSE_REQUIRE_SHARED_DATA();
   const auto& hyps = icbinScene2().result.detections;  // on distinct cups (the test above)
   const DetectionResult& r = icbinScene2Poses().result;
-  // Measured with the CLI's bank: 8 accepted of 36 candidates (6 of 18 without stage 5's
-  // runners-up); cups pressed against cups at the same depth show too little of a depth step
-  // around their outline and are rejected (see VerifyParams).
+  // Measured with the CLI's bank: 10 accepted (8 before the silhouette counted over what the
+  // scene does not hide; 6 without stage 5's runners-up); cups pressed against cups at the same
+  // depth show too little of a depth step around their outline and are rejected (VerifyParams).
   EXPECT_GE(r.detections.size(), 4u);
+  // Since the silhouette test counts over the outline nothing hides (2026-12-01), 10: one more
+  // is a cup lying at the right of the pile, lid to the lower left, found from a runner-up
+  // that the stages-1-5 run drops (checked by hand on the overlay).
+  std::vector<cv::Point2f> cups{{442, 239}};
+  for (const auto& h : hyps) cups.emplace_back(h.x, h.y);
   for (const Detection& d : r.detections) {
     EXPECT_TRUE(d.verified);
     bool on_cup = false;
-    for (const auto& h : hyps) on_cup = on_cup || std::hypot(d.x - h.x, d.y - h.y) < 20.f;
+    for (const auto& c : cups) on_cup = on_cup || std::hypot(d.x - c.x, d.y - c.y) < 20.f;
     EXPECT_TRUE(on_cup) << "a pose at " << d.x << "," << d.y << " is on none of the cups";
-    EXPECT_GT(d.collision_rate, 0.4f);
+    // phi over the points nothing hides passes 0.4 (verify.occlusion_credit): over all of them
+    // at least 0.4 x (1 - credit).
+    EXPECT_GT(d.collision_rate, 0.4f * (1.f - DetectorParams{}.verify.occlusion_credit));
     // Mean squared pair distance under (5.5 mm)^2 where the score says the pose is sure (0.5,
     // docs/evaluation.md). Below it a pose may fit more loosely: since stage 5's runners-up
     // (2026-11-28), a cup leaning at the back, half hidden, is found at score 0.22 with 38.7 mm^2

@@ -268,6 +268,42 @@ TEST(Verify, ContourEdgesAreWhereTheOutlineMeetsAnImageEdge) {
   EXPECT_GT(contourEdgeSupport(face(cut), imageEdges(cut_bgr), cut_depth, camera, 0.01f), 0.95f);
 }
 
+// The silhouette test over what the scene does not hide (VerifyParams::occlusion_credit): a part
+// whose outline runs behind a nearer object shows no depth step there, right pose or not.
+// Those samples leave the count, but at most `credit` of them: a part mostly hidden, or a
+// model sunk behind a surface (every sample "hidden"), still needs steps of its own.
+TEST(Verify, TheSilhouetteCountsWhatTheSceneDoesNotHide) {
+  const Camera camera = smallCamera(160, 120, 150.0);
+  PointCloud model;  // a 60 x 60 px face at 1 m
+  const cv::Rect face(50, 30, 60, 60);
+  for (int v = face.y; v < face.y + face.height; ++v)
+    for (int u = face.x; u < face.x + face.width; ++u)
+      model.emplace_back(static_cast<float>((u - camera.cx) / camera.fx), static_cast<float>((v - camera.cy) / camera.fy),
+                         1.f);
+  cv::Mat depth(120, 160, CV_32FC1, cv::Scalar(1.2f));
+  depth(face).setTo(1.0f);
+  EXPECT_GT(silhouetteSupport(model, depth, camera, 0.01f), 0.95f) << "in plain sight";
+  EXPECT_GT(silhouetteSupport(model, depth, camera, 0.01f, 0.5f), 0.95f);
+
+  // An occluder 10 cm nearer covers the face's left half: its outline there has no step.
+  cv::Mat occluded = depth.clone();
+  occluded(cv::Rect(0, 0, face.x + 30, 120)).setTo(0.9f);
+  const float plain = silhouetteSupport(model, occluded, camera, 0.01f);
+  const float credited = silhouetteSupport(model, occluded, camera, 0.01f, 0.5f);
+  EXPECT_LT(plain, 0.55f) << "the paper's test counts the hidden outline against it";
+  EXPECT_GT(credited, 0.9f) << "the outline the scene shows steps back all along";
+
+  // About 80 % hidden (all but the top right): the credit stops at half of the outline.
+  cv::Mat mostly = occluded.clone();
+  mostly(cv::Rect(0, face.y + 30, 160, 60)).setTo(0.9f);
+  EXPECT_LT(silhouetteSupport(model, mostly, camera, 0.01f, 0.5f), 0.55f);
+
+  // Sunk behind a surface 5 cm in front of it: every sample hidden, no step seen.
+  const cv::Mat wall(120, 160, CV_32FC1, cv::Scalar(0.95f));
+  EXPECT_EQ(silhouetteSupport(model, wall, camera, 0.01f, 0.5f), 0.f);
+  EXPECT_EQ(silhouetteSupport(model, wall, camera, 0.01f), 0.f);
+}
+
 // Picking's outline test (outlineOnEdges): the outline's nearest image edge must lie within
 // 1.5 px of it. A look-alike whose outline meets edges within the contour test's 2 px along its
 // long sides, but strays at its ends, scores low; so does the right outline 3 px off. A
