@@ -133,6 +133,7 @@ float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat
   if (!usable) return 0.f;
   const float hidden_share = static_cast<float>(hidden) / static_cast<float>(usable);
   const float counted = std::max(1.f - hidden_share, 1.f - occlusion_credit);
+  if (!(counted > 0.f)) return 0.f;  // all hidden, at a credit of 1: no step seen
   return static_cast<float>(steps) / (static_cast<float>(usable) * counted);
 }
 

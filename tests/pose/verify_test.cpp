@@ -302,6 +302,7 @@ TEST(Verify, TheSilhouetteCountsWhatTheSceneDoesNotHide) {
   const cv::Mat wall(120, 160, CV_32FC1, cv::Scalar(0.95f));
   EXPECT_EQ(silhouetteSupport(model, wall, camera, 0.01f, 0.5f), 0.f);
   EXPECT_EQ(silhouetteSupport(model, wall, camera, 0.01f), 0.f);
+  EXPECT_EQ(silhouetteSupport(model, wall, camera, 0.01f, 1.f), 0.f) << "a credit of 1 divides by nothing";
 }
 
 // Picking's outline test (outlineOnEdges): the outline's nearest image edge must lie within
