@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
+#include "pose/verify.hpp"
+
 namespace vkpose {
 
 namespace {
@@ -144,7 +146,7 @@ float poseScore(const PoseEvidence& e) {
 }
 
 float unhiddenCollisionRate(const PoseEvidence& e, const VerifyParams& vp) {
-  const float unhidden = std::max(1.f - e.depth.occluded, 1.f - vp.occlusion_credit);
+  const float unhidden = unhiddenShare(e.depth.occluded, vp.occlusion_credit);
   return unhidden > 0.f ? e.collision.collision_rate / unhidden : e.collision.collision_rate;
 }
 

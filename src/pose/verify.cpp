@@ -28,6 +28,12 @@ float depthAt(const cv::Mat& depth_m, float x, float y) {
   return depth_m.at<float>(v, u);
 }
 
+/// Whether the scene just inside an outline sample (`z_in`, 0: no depth) lies `jump` or more in
+/// front of the model there (`model_z_in`, 0: unknown): something nearer hides that stretch.
+bool hiddenByNearer(float z_in, float model_z_in, float jump) {
+  return z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump;
+}
+
 /// Whether an outline sample can say anything about the image's edges: no occluder hides it
 /// (the scene inside the outline nearer than the model, or something right outside standing
 /// in front: its edges are the occluder's), and it lies `border` px or more inside the image
@@ -36,7 +42,7 @@ bool edgeSampleUsable(const OutlineSample& sample, const cv::Mat& scene_depth_m,
   const auto& [c, normal, model_z_in] = sample;
   const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
   const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
-  if (z_in > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) return false;
+  if (hiddenByNearer(z_in, model_z_in, jump)) return false;
   if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) return false;
   return c.x() >= border && c.y() >= border && c.x() < float(scene_depth_m.cols) - border &&
          c.y() < float(scene_depth_m.rows) - border;
@@ -107,6 +113,10 @@ std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const 
   return samples;
 }
 
+float unhiddenShare(float hidden_share, float occlusion_credit) {
+  return std::max(1.f - hidden_share, 1.f - occlusion_credit);
+}
+
 float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_depth_m, const Camera& camera,
                         float jump, float occlusion_credit) {
   return silhouetteSupport(outlineSamples(model_points, camera, scene_depth_m.size()), scene_depth_m, jump,
@@ -124,15 +134,14 @@ float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat
     ++usable;
     // Behind something nearer (the scene inside the outline lies in front of the model): no
     // step to see there, whether the pose is right or not.
-    if (occlusion_credit > 0.f && model_z_in > 0.f && z_in < model_z_in - jump) {
+    if (occlusion_credit > 0.f && hiddenByNearer(z_in, model_z_in, jump)) {
       ++hidden;
       continue;
     }
     steps += z_out >= z_in + jump;
   }
   if (!usable) return 0.f;
-  const float hidden_share = static_cast<float>(hidden) / static_cast<float>(usable);
-  const float counted = std::max(1.f - hidden_share, 1.f - occlusion_credit);
+  const float counted = unhiddenShare(static_cast<float>(hidden) / static_cast<float>(usable), occlusion_credit);
   if (!(counted > 0.f)) return 0.f;  // all hidden, at a credit of 1: no step seen
   return static_cast<float>(steps) / (static_cast<float>(usable) * counted);
 }

@@ -53,6 +53,11 @@ struct OutlineSample {
 /// same samples: the detector computes them once a pose.
 std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const Camera& camera, cv::Size size);
 
+/// The share of a pose's points or outline samples that stage 8 counts when `hidden_share` of
+/// them lie behind something nearer: the rest, but at least 1 - `occlusion_credit`
+/// (VerifyParams::occlusion_credit; a pose sunk into a surface also looks hidden).
+float unhiddenShare(float hidden_share, float occlusion_credit);
+
 /// The silhouette test's share (see VerifyParams::silhouette_jump): the outline of the
 /// camera-frame model points projected into the image, sampled every pixel; at each sample the
 /// scene depth 3 px inside and 4 px outside along the outline's normal. Samples where either
