@@ -270,18 +270,29 @@ void validateTrainingParams(const TrainingParams& params);
 /// part end (an 11 mm nut at 0.36 m, 1.1 cells, fired on screw heads all over a real pile).
 /// `vkpose train` refuses it unless --allow-small.
 inline constexpr float kMinPartCells = 2.f;
+/// A part narrower than this many cells of LINEMOD's coarsest level at the nearest training
+/// distance (its width: the middle of its three extents, a rod's or a screw's diameter) is a
+/// line there. LINEMOD's orientations have no polarity, so a straight edge, a rod or a bin's
+/// rim matches it as well as the part does: a 48 mm M3 screw (5.5 mm wide, 0.6 cells at 0.3 m)
+/// fired on the rods and rims of metal piles, 11-51 wrong a pile and none right. `vkpose train`
+/// refuses it unless --allow-small.
+inline constexpr float kMinWidthCells = 1.f;
 
 /// How large the part looks where it is trained and what the sensor resolves there, the
 /// evidence a detection of it can have (`vkpose train` prints summary()).
 struct PartSizeEvidence {
   float diameter_m = 0.f, thinnest_m = 0.f;  ///< largest and smallest extent (bounding box side)
+  float width_m = 0.f;                        ///< the middle extent: narrower than this from no side
   float nearest_m = 0.f, farthest_m = 0.f;   ///< training distances
   float pixels_near = 0.f, pixels_far = 0.f;  ///< the diameter in pixels at each
   float cells_near = 0.f, cells_far = 0.f;    ///< the same in cells of LINEMOD's coarsest level
+  float width_cells_near = 0.f;               ///< the width in those cells at the nearest distance
   float thin_pixels_far = 0.f;                ///< the thinnest extent in pixels at the farthest
   float pixel_mm_near = 0.f, pixel_mm_far = 0.f;  ///< what one pixel spans there, millimetres
-  /// Under kMinPartCells at the nearest distance.
-  bool too_small() const { return cells_near < kMinPartCells; }
+  /// Under kMinWidthCells wide at the nearest distance: a line to LINEMOD's coarsest level.
+  bool line_like() const { return width_cells_near < kMinWidthCells; }
+  /// Under kMinPartCells across, or line_like(), at the nearest distance.
+  bool too_small() const { return cells_near < kMinPartCells || line_like(); }
   /// Thinner than a structured-light or stereo sensor's matching window resolves (about 4
   /// pixels, half a 7-9 pixel window): its depth merges into what lies behind it.
   bool thin_in_depth() const { return thin_pixels_far < 4.f; }

@@ -273,7 +273,7 @@ symmetric: score the object with ADI. up: the object's up axis, 'auto' (the end 
 the up axis only), 'all' (also a hemisphere about each other pose it rests in, lying or upside
 down, that no near-symmetry covers: up to 6x the templates) or 'auto' (all for a part smaller
 than 10 cm across or trained nearer than 0.5 m, up otherwise). allow_small: train a part under
-2 cells of LINEMOD's coarsest level across at the nearest radius, which raises ValueError
+2 cells of LINEMOD's coarsest level across (or 1 wide) at the nearest radius, which raises ValueError
 otherwise (too small to tell from its neighbourhood). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");

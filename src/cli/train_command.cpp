@@ -159,7 +159,7 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_flag("--allow-small", opt->allow_small,
                "Train a part too small to tell from its neighbourhood where it is trained (under 2 cells of "
-               "LINEMOD's coarsest level across at the nearest --radii), which train refuses otherwise");
+               "LINEMOD's coarsest level across, or under 1 wide, at the nearest --radii), which train refuses otherwise");
   sub->add_option("--max-view-angle", opt->max_view_angle,
                   "Keep only viewpoints within this angle of the object's up axis, degrees (e.g. 40 for parts that stand "
                   "upright under a camera looking down)")

@@ -36,7 +36,10 @@ double coarseCellPixels(const TrainingParams& params) {
 PartSizeEvidence partSizeEvidence(const Mesh& mesh, const TrainingParams& params) {
   PartSizeEvidence e;
   e.diameter_m = mesh.diameter;
-  e.thinnest_m = (mesh.bbox_max - mesh.bbox_min).minCoeff();
+  Eigen::Vector3f extent = mesh.bbox_max - mesh.bbox_min;
+  std::sort(extent.data(), extent.data() + 3);
+  e.thinnest_m = extent[0];
+  e.width_m = extent[1];
   e.nearest_m = std::min(params.views.radii.from, params.views.radii.to);
   e.farthest_m = std::max(params.views.radii.from, params.views.radii.to);
   const float f = 0.5f * static_cast<float>(params.camera.fx + params.camera.fy);
@@ -47,6 +50,7 @@ PartSizeEvidence partSizeEvidence(const Mesh& mesh, const TrainingParams& params
   e.thin_pixels_far = f * e.thinnest_m / e.farthest_m;
   e.cells_near = cell > 0.f ? e.pixels_near / cell : 0.f;
   e.cells_far = cell > 0.f ? e.pixels_far / cell : 0.f;
+  e.width_cells_near = cell > 0.f ? f * e.width_m / e.nearest_m / cell : 0.f;
   e.pixel_mm_near = 1e3f * e.nearest_m / f;
   e.pixel_mm_far = 1e3f * e.farthest_m / f;
   return e;
@@ -71,6 +75,16 @@ std::string PartSizeEvidence::summary() const {
 }
 
 std::string PartSizeEvidence::refusal() const {
+  if (cells_near >= kMinPartCells && line_like()) {
+    // Where the part would span one cell: width * f / distance = one cell's pixels.
+    const float within_m = width_cells_near > 0.f ? nearest_m * width_cells_near / kMinWidthCells : 0.f;
+    return fmt::format(
+        "{:.1f} mm wide at {:.2f} m is {:.1f} cells of LINEMOD's coarsest level, under the {:.0f} a part needs: "
+        "there it is a line, and LINEMOD's orientations, which have no polarity, find it along every straight "
+        "edge, rod and bin rim of a scene (a 48 mm M3 screw at 0.3-0.5 m: 11-51 wrong a pile, none right). "
+        "Train (and detect) within {:.2f} m, with a longer focal length, or pass --allow-small to train it anyway",
+        1e3f * width_m, nearest_m, width_cells_near, kMinWidthCells, within_m);
+  }
   return fmt::format(
       "{:.0f} mm across at {:.2f} m is {:.0f} pixels, {:.1f} cells of LINEMOD's coarsest level, under the {:.0f} "
       "a part needs to be told from its neighbourhood: its few features fit any screw head or part end, and a "

@@ -181,10 +181,22 @@ TEST(UpAxis, SizeEvidenceRefusesAPartTooSmallToTellFromItsNeighbourhood) {
   EXPECT_GT(bracket.cells_far, 2.5f);
   EXPECT_FALSE(bracket.thin_in_depth()) << bracket.summary();
 
+  // A screw 50 mm long is long enough, but 3 mm wide it is a line to the coarse level (0.36
+  // cells at 0.3 m): refused, and told where it would be trained (within 0.11 m).
   const PartSizeEvidence screw = partSizeEvidence(test::boxMesh({0.003f, 0.003f, 0.05f}), params);
-  EXPECT_FALSE(screw.too_small()) << screw.summary();
+  EXPECT_GT(screw.cells_near, kMinPartCells);
+  EXPECT_NEAR(screw.width_m, 0.003f, 1e-4f);
+  EXPECT_TRUE(screw.line_like());
+  EXPECT_TRUE(screw.too_small()) << screw.summary();
+  EXPECT_NE(screw.refusal().find("3.0 mm wide at 0.30 m is 0.4 cells"), std::string::npos) << screw.refusal();
+  EXPECT_NE(screw.refusal().find("within 0.11 m"), std::string::npos) << screw.refusal();
+  EXPECT_NE(screw.refusal().find("--allow-small"), std::string::npos);
   EXPECT_TRUE(screw.thin_in_depth());
   EXPECT_NE(screw.summary().find("thinnest side, 3.0 mm"), std::string::npos) << screw.summary();
+  // A flat plate is thin from one side only: wide enough seen from above.
+  const PartSizeEvidence plate = partSizeEvidence(test::boxMesh({0.04f, 0.03f, 0.002f}), params);
+  EXPECT_FALSE(plate.line_like()) << plate.summary();
+  EXPECT_FALSE(plate.too_small());
 }
 
 // planTraining: what `vkpose train` and vkpose.train() decide before rendering. A brick 4 cm
