@@ -132,6 +132,8 @@ std::vector<ConfigField> verifyFields(DetectorParams& p) {
       {"verify", "small_part_min_colour_agreement", "the same for parts under 10 cm (their depth tests say less)", &p.verify.small_part_min_colour_agreement, closed(-1, 1)},
       {"verify", "min_outline_on_edges",
        "share of the visible outline whose nearest image edge lies within 1.5 px of it (0: off)", &p.verify.min_outline_on_edges, closed(0, 1)},
+      {"verify", "small_turned_part_min_outline_on_edges",
+       "the same for parts under 10 cm that are bodies of revolution (the larger of the two counts)", &p.verify.small_turned_part_min_outline_on_edges, closed(0, 1)},
       {"verify", "second_try_min_collision",
        "collision rate a pose needs when stage 6 had to move its start along the camera's axis (the larger of this and threshold)", &p.verify.second_try_min_collision, closed(0, 1)},
       {"verify", "twin_distance_fraction", "refined poses of one object this close (share of the diameter) ...", &p.verify.twin_distance_fraction, closed(0, 1)},

@@ -159,6 +159,14 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
   return out;
 }
 
+VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank) {
+  if (!isSmallPart(bank.diameter)) return verify;
+  verify.min_colour_agreement = verify.small_part_min_colour_agreement;
+  if (bank.symmetric || revolutionAxis(bank.near_symmetries))
+    verify.min_outline_on_edges = std::max(verify.min_outline_on_edges, verify.small_turned_part_min_outline_on_edges);
+  return verify;
+}
+
 void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                   const PoseFrame& frame, const DetectorParams& params) {
   const Camera& camera = frame.camera;
@@ -190,11 +198,10 @@ void initialPoses(std::vector<PoseCandidate>& candidates, const std::vector<Pose
   // The lengths of stages 7-8 for each candidate's object at its distance (scaledForObject:
   // the defaults for objects of 10 cm and more), and a small part's own colour test.
   for (PoseCandidate& c : candidates) {
-    const float diameter = objects[c.bank()].bank->diameter;
-    const DetectorParams scaled = scaledForObject(params, diameter, c.start.t.z());
+    const TemplateBank& bank = *objects[c.bank()].bank;
+    const DetectorParams scaled = scaledForObject(params, bank.diameter, c.start.t.z());
     c.refine = scaled.refine;
-    c.verify = scaled.verify;
-    if (isSmallPart(diameter)) c.verify.min_colour_agreement = params.verify.small_part_min_colour_agreement;
+    c.verify = partVerifyParams(scaled.verify, bank);
     // A second try's raised limit keeps the first fit's margin under the plain one: on the
     // tuning sets, what MLS and ICP add to a second try's collision rate stayed under 0.07.
     c.first_fit_min_collision = c.refine.first_fit_share * c.verify.threshold;

@@ -125,6 +125,12 @@ std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypoth
 std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vector<TemplateBank>& banks,
                                             const Camera& camera, const DetectorParams& params, int starts);
 
+/// Stage 8's tests as `bank`'s object gets them: a part under 10 cm asks more of its colour
+/// (small_part_min_colour_agreement), and one that is a body of revolution (trained
+/// --symmetric, or revolutionAxis() in its near-symmetries) more of its outline on the image's
+/// edges (small_turned_part_min_outline_on_edges); larger objects keep `verify`.
+VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank);
+
 /// Stage 6, translations: each start rendered in its own window (projectedWindow: one small
 /// submit each) and moved by the centroid difference (initialTranslation); then each
 /// candidate's stage 7-8 parameters, scaled for its object at its distance, with the higher

@@ -15,6 +15,8 @@
 #include "pose/candidate.hpp"
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
+#include "synth/procedural_meshes.hpp"
+#include "mesh_support.hpp"
 #include "test_support.hpp"
 #include "vkpose/bank.hpp"
 #include "vkpose/error.hpp"
@@ -361,6 +363,44 @@ TEST(StageEight, TheOutlineOnEdgesTestIsOffUntilAsked) {
       << stageEightShortfall(c);
   c.evidence.outline_on_edges = 0.8f;
   EXPECT_EQ(stageEightShortfall(c), "");
+}
+
+// A part under 10 cm asks more of its colour; one that is a body of revolution (a nozzle, a
+// pin) also asks 0.7 of its outline on the image's edges. A flat part of that size keeps the
+// outline test off (a bracket's right poses measure from 0.48), and so does a larger object.
+TEST(StageEight, ASmallTurnedPartsOutlineMustLieOnItsEdges) {
+  Mesh nozzle = procedural::lathe({{0.f, 0.f}, {0.01f, 0.f}, {0.01f, 0.058f}, {0.f, 0.058f}}, 48, {0.6f, 0.6f, 0.6f});
+  finishMesh(nozzle);
+  const auto bankOf = [](const Mesh& mesh) {
+    TemplateBank bank;
+    bank.mesh = mesh;
+    bank.diameter = mesh.diameter;
+    bank.near_symmetries = findNearSymmetries(mesh, 0.03f * mesh.diameter);
+    return bank;
+  };
+  const TemplateBank turned = bankOf(nozzle);
+  ASSERT_TRUE(revolutionAxis(turned.near_symmetries).has_value());
+  const VerifyParams defaults;
+  EXPECT_EQ(defaults.min_outline_on_edges, 0.f);
+  const VerifyParams small_turned = partVerifyParams(defaults, turned);
+  EXPECT_FLOAT_EQ(small_turned.min_outline_on_edges, 0.7f);
+  EXPECT_FLOAT_EQ(small_turned.min_colour_agreement, 0.45f);
+
+  TemplateBank flat = bankOf(test::boxMesh({0.04f, 0.02f, 0.012f}));
+  ASSERT_FALSE(revolutionAxis(flat.near_symmetries).has_value());
+  EXPECT_FLOAT_EQ(partVerifyParams(defaults, flat).min_outline_on_edges, 0.f);
+  EXPECT_FLOAT_EQ(partVerifyParams(defaults, flat).min_colour_agreement, 0.45f);
+  flat.symmetric = true;  // trained --symmetric: the user says it is a body of revolution
+  EXPECT_FLOAT_EQ(partVerifyParams(defaults, flat).min_outline_on_edges, 0.7f);
+
+  TemplateBank large = turned;  // the same shape 14 cm across (a cup): the defaults stand
+  large.diameter = 0.14f;
+  EXPECT_FLOAT_EQ(partVerifyParams(defaults, large).min_outline_on_edges, 0.f);
+  EXPECT_FLOAT_EQ(partVerifyParams(defaults, large).min_colour_agreement, 0.2f);
+
+  VerifyParams stricter;  // a user's higher setting for every object stays
+  stricter.min_outline_on_edges = 0.8f;
+  EXPECT_FLOAT_EQ(partVerifyParams(stricter, turned).min_outline_on_edges, 0.8f);
 }
 
 TEST(FirstFit, StopsStartsShortOfStageEightsLimitsAndSaysWhy) {
