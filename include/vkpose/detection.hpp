@@ -60,6 +60,9 @@ struct Detection {
   /// shows several colours, a match of the colour itself where it shows one; 1 when not
   /// measured (a mesh without vertex colours, or the test turned off).
   float colour_agreement = 1.f;
+  /// colour_agreement was measured (the mesh has colours, the rendering shows enough of them
+  /// and the test is on); picking leans less on the outline of a pose whose colour passed.
+  bool colour_measured = false;
   /// Posed without depth (colour-only frames): the pose was fitted to the image's edges,
   /// `contour_edges` and `colour_agreement` verified it, and no depth test ran.
   bool colour_only = false;

@@ -121,6 +121,12 @@ struct PickParams {
   /// 0.33-0.82 where right, so a scan's picks are refused more often (a refused part is seen
   /// again after the next pick). 0: off; detections that did not measure it are not held back.
   float min_colour_agreement = 0.5f;
+  /// The outline gate asks this much less (min_outline_on_edges - this) of a detection whose
+  /// colour was measured and reached min_colour_agreement: the look-alike of the part's size
+  /// that the outline gate keeps out is what its colour has already told apart, and a part
+  /// partly under others keeps less of its outline on the image's edges. Without colours (a
+  /// bank from an STL) the gate stays whole: there it is all that keeps clutter cylinders out.
+  float colour_outline_allowance = 0.1f;
 };
 
 /// A grasp placed at a detection.

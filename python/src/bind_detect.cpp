@@ -190,6 +190,7 @@ py::dict detectionDict(const Detection& d) {
   out["contour_edges"] = tidy(d.contour_edges);
   if (std::isfinite(d.outline_on_edges)) out["outline_on_edges"] = tidy(d.outline_on_edges);
   out["colour_agreement"] = tidy(d.colour_agreement);
+  out["colour_measured"] = d.colour_measured;
   out["icp_fitness"] = d.icp_fitness;
   out["icp_iterations"] = d.icp_iterations;
   out["rotation_votes"] = d.rotation_votes;
@@ -394,6 +395,8 @@ leaves the config as it was.)")
                              })
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
                              "Correlation of the rendered mesh's chromaticity with the frame's; 1 when not measured")
+      .def_property_readonly("colour_measured", [](const PyDetection& p) { return p.d.colour_measured; },
+                             "colour_agreement was measured (the mesh has colours and the rendering shows them)")
       .def_property_readonly("icp_fitness", [](const PyDetection& p) { return p.d.icp_fitness; },
                              "Mean squared ICP pair distance, m^2")
       .def_property_readonly("icp_iterations", [](const PyDetection& p) { return p.d.icp_iterations; })
@@ -612,7 +615,7 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
       "plan_picks",
       [](const PyResult& result, const py::object& grasps, const py::object& depth, const py::object& bin,
          const std::string& order, float max_tilt, const py::object& approach_axis, float min_outline_on_edges,
-         float min_colour_agreement) {
+         float min_colour_agreement, float colour_outline_allowance) {
         if (!result.frame) valueError("result: a Result of Detector.detect()");
         const auto& banks = result.frame->state->detector->banks();
         PickParams params;
@@ -620,6 +623,7 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
         params.max_tilt_deg = max_tilt;
         params.min_outline_on_edges = shareOf(min_outline_on_edges, "min_outline_on_edges");
         params.min_colour_agreement = shareOf(min_colour_agreement, "min_colour_agreement");
+        params.colour_outline_allowance = shareOf(colour_outline_allowance, "colour_outline_allowance");
         if (!approach_axis.is_none()) params.approach_axis = vector3Of(approach_axis, "approach_axis");
         std::vector<std::string> files;
         if (py::isinstance<py::str>(grasps) || py::hasattr(grasps, "__fspath__")) {
@@ -648,6 +652,7 @@ hypotheses, in red. depth: the frame's depth, to put beside the colour in false 
       py::arg("order") = "combined", py::arg("max_tilt") = PickParams{}.max_tilt_deg,
       py::arg("approach_axis") = py::none(), py::arg("min_outline_on_edges") = PickParams{}.min_outline_on_edges,
       py::arg("min_colour_agreement") = PickParams{}.min_colour_agreement,
+      py::arg("colour_outline_allowance") = PickParams{}.colour_outline_allowance,
       R"(Bin picking on a Result, as `vkpose detect --grasps` does (docs/picking.md): each grasp file's
 grasps placed at the detections of its object, refused where the gripper would hit the bin, the
 scene or another detection, and the detections ordered into a pick list. Returns {"grasps": [per
@@ -659,7 +664,9 @@ bin file. order: combined, height, score or visible. max_tilt: degrees from appr
 (default: down into the bin, or the camera's viewing direction (0, 0, 1) without one).
 min_outline_on_edges: a detection is picked only when this share of its outline lies on the
 image's edges (Detection.outline_on_edges; 0: off). min_colour_agreement: and only when its colour
-agrees with its model's this much (Detection.colour_agreement, where the mesh has colours; 0: off).)");
+agrees with its model's this much (Detection.colour_agreement, where the mesh has colours; 0: off).
+colour_outline_allowance: min_outline_on_edges asks this much less of a detection whose colour was
+measured (Detection.colour_measured) and passed min_colour_agreement.)");
 }
 
 }  // namespace vkpose::python

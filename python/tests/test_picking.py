@@ -48,6 +48,6 @@ def test_a_cups_grasp_is_offered_for_every_detected_cup(icbin, icbin_bank, cli, 
     other.write_text(json.dumps(dict(CUP_GRASPS, object="mug")))
     with pytest.raises(ValueError, match="no bank is for"):
         vkpose.plan_picks(result, other, depth)
-    for share in ("min_outline_on_edges", "min_colour_agreement"):
+    for share in ("min_outline_on_edges", "min_colour_agreement", "colour_outline_allowance"):
         with pytest.raises(ValueError, match=share + r" must be in \[0, 1\]"):
             vkpose.plan_picks(result, grasps, depth, **{share: 1.5})

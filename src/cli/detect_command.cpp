@@ -381,6 +381,13 @@ void addPickFlags(CLI::App* sub, CLI::Option* grasps, std::string& pick_order, P
       ->capture_default_str()
       ->needs(grasps)
       ->group(group);
+  sub->add_option("--colour-outline-allowance", pick.colour_outline_allowance,
+                  "--min-outline-fit asks this much less of a detection whose colour was measured and passed "
+                  "--min-colour-fit")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->needs(grasps)
+      ->group(group);
 }
 
 Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {

@@ -72,6 +72,7 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["contour_edges"] = round(d.contour_edges, 4);
     if (std::isfinite(d.outline_on_edges)) j["outline_on_edges"] = round(d.outline_on_edges, 4);
     j["colour_agreement"] = round(d.colour_agreement, 4);
+    j["colour_measured"] = d.colour_measured;
     j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision
     j["icp_iterations"] = d.icp_iterations;
     j["rotation_votes"] = d.rotation_votes;
@@ -80,6 +81,7 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["contour_edges"] = round(d.contour_edges, 4);
     j["explained_edges"] = round(d.explained_edges, 4);
     j["colour_agreement"] = round(d.colour_agreement, 4);
+    j["colour_measured"] = d.colour_measured;
     j["contour_iterations"] = d.icp_iterations;
     j["rotation_votes"] = d.rotation_votes;
   }

@@ -281,11 +281,14 @@ PlacedGrasp placeGrasp(const Grasp& g, const Pose& object_pose, const Eigen::Vec
 /// Why a detection is not picked at all, whatever its grasps: its outline strays from the
 /// image's edges, or its colour disagrees with its model's; "" when neither.
 std::string poseTooUncertainToPick(const Detection& d, const PickParams& params) {
-  if (d.outline_on_edges < params.min_outline_on_edges)  // false for NaN: not measured
-    return fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %): too "
+  const bool colour_gate = params.min_colour_agreement > 0.f;
+  const bool colour_passed = colour_gate && d.colour_measured && d.colour_agreement >= params.min_colour_agreement;
+  const float min_outline = params.min_outline_on_edges - (colour_passed ? params.colour_outline_allowance : 0.f);
+  if (params.min_outline_on_edges > 0.f && d.outline_on_edges < min_outline)  // false for NaN: not measured
+    return fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %{}): too "
                        "uncertain a pose to grip, or something else of its size",
-                       100.f * d.outline_on_edges, 100.f * params.min_outline_on_edges);
-  if (params.min_colour_agreement > 0.f && d.colour_agreement < params.min_colour_agreement)
+                       100.f * d.outline_on_edges, 100.f * min_outline, colour_passed ? ", its colour having passed" : "");
+  if (colour_gate && d.colour_agreement < params.min_colour_agreement)
     return fmt::format("its colour agrees with the model's {:.2f} (a pick needs {:.2f}): something else of its shape",
                        d.colour_agreement, params.min_colour_agreement);
   return {};

@@ -164,6 +164,7 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
         const bool colour_counts = !objects[c.bank()].bank->mesh.colours.empty() && colour.colour_informative;
         d.colour_agreement = colour_counts ? colour.colour : 1.f;
+        d.colour_measured = colour_counts;
         d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
         d.score = d.contour_edges * d.explained_edges * (colour_counts ? 0.5f * (1.f + colour.colour) : 1.f);
         if (d.contour_edges < cp.min_contour_support)

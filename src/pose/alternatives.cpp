@@ -161,7 +161,7 @@ void resolveNearSymmetries(PoseCandidate& c, const PoseObject& object, const Pos
   }
   const float margin = params.verify.symmetry_margin;
   const auto [chosen, won_by] = chooseAlternative(alts, margin);
-  if (informative) d.colour_agreement = alts[chosen].colour;
+  if (informative) d.colour_agreement = alts[chosen].colour, d.colour_measured = true;
   if (turns) {
     d.symmetry_chosen = static_cast<int>(chosen);
     d.symmetry_margin = won_by;
@@ -198,7 +198,7 @@ void resolveLookAlikes(PoseCandidate& c, const PoseObject& object, const PoseFra
   Detection& d = c.detection;
   d.look_alike_chosen = static_cast<int>(chosen);
   d.look_alike_margin = won_by;
-  if (chosen != 0 && cmp.informative) d.colour_agreement = cmp.alternatives[chosen].colour;
+  if (chosen != 0 && cmp.informative) d.colour_agreement = cmp.alternatives[chosen].colour, d.colour_measured = true;
   d.look_alike_alternatives = std::move(cmp.alternatives);
   if (chosen == 0) return;
   // Verified as any pose is, from the model surface its own rendering shows; a composed

@@ -288,6 +288,7 @@ TEST(Picking, APoseWhoseColourDisagreesWithItsModelIsNotPicked) {
   other.outline_on_edges = same.outline_on_edges = 0.9f;
   other.colour_agreement = 0.3f;
   same.colour_agreement = 0.85f;  // uncoloured keeps 1: a mesh without colours measures nothing
+  other.colour_measured = same.colour_measured = true;
   const PickPlan plan = planPicks({other, same, uncoloured}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
   ASSERT_EQ(plan.detections.size(), 3u);
   EXPECT_TRUE(plan.detections[0].valid.empty());
@@ -301,6 +302,37 @@ TEST(Picking, APoseWhoseColourDisagreesWithItsModelIsNotPicked) {
   PickParams off;
   off.min_colour_agreement = 0.f;
   EXPECT_FALSE(planPicks({other}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, off).picks.empty());
+}
+
+TEST(Picking, AColourThatPassedLetsLessOfTheOutlineSitOnEdges) {
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
+  // A part partly under others, 45 % of its outline on the image's edges (the gate is 50 %).
+  Detection coloured = detectionAt(lyingCan(0.f));
+  coloured.outline_on_edges = 0.45f;
+  Detection uncoloured = coloured, too_loose = coloured;
+  coloured.colour_measured = too_loose.colour_measured = true;
+  coloured.colour_agreement = 0.85f;
+  too_loose.outline_on_edges = 0.35f;  // under the gate less the allowance
+  const auto refusal = [&](const Detection& d, const PickParams& params) {
+    const PickPlan plan = planPicks({d}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, params);
+    return plan.detections.at(0).valid.empty() ? plan.detections.at(0).refused.at(0).reason : std::string();
+  };
+  EXPECT_EQ(refusal(coloured, {}), "") << "its colour was measured and passed: 40 % of the outline is enough";
+  EXPECT_NE(refusal(uncoloured, {}).find("for 45 % of it (a pick needs 50 %)"), std::string::npos)
+      << "no colour measured (a mesh without colours): the whole gate";
+  EXPECT_NE(refusal(too_loose, {}).find("for 35 % of it (a pick needs 40 %, its colour having passed)"),
+            std::string::npos)
+      << refusal(too_loose, {});
+  PickParams no_allowance;
+  no_allowance.colour_outline_allowance = 0.f;
+  EXPECT_NE(refusal(coloured, no_allowance), "");
+  PickParams colour_gate_off;  // a colour that no gate asked about vouches for nothing
+  colour_gate_off.min_colour_agreement = 0.f;
+  EXPECT_NE(refusal(coloured, colour_gate_off), "");
+  Detection failed = coloured;  // a colour that failed vouches for nothing either
+  failed.colour_agreement = 0.3f;
+  EXPECT_NE(refusal(failed, {}).find("(a pick needs 50 %)"), std::string::npos) << refusal(failed, {});
 }
 
 TEST(Picking, TheTruthTellsWhetherAnythingCouldBeTaken) {
