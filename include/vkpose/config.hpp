@@ -337,7 +337,7 @@ struct VerifyParams {
   /// the synthetic metal piles 0.7 makes the nozzles precise (right ones 0.81-0.94, ones laid
   /// on other parts 0.56-0.64) and halves the screws' wrong detections, but the 40 mm
   /// bracket's right poses measure 0.48-0.96 (its bin bar: F1 0.95 -> 0.82) and LM-O's glue
-  /// 0.42, so it is off by default; turn it on for piles of small turned parts.
+  /// 0.42, so it is off by default (small_turned_part_min_outline_on_edges is not).
   float min_outline_on_edges = 0.f;
   /// The same for a part under 10 cm that is a body of revolution (a turned part: a nozzle, a
   /// pin, a bushing; the bank trained --symmetric or revolutionAxis() found in its
