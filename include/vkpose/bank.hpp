@@ -146,6 +146,15 @@ struct NearSymmetry {
 /// tolerance <= 0 gives none.
 std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m, int max_count = 7);
 
+/// The near-symmetries (within 1 % of the diameter) that map the mesh onto itself: every
+/// vertex turned lands within `tolerance_m` of a vertex of the same colour (within 0.1 a
+/// channel). findNearSymmetries asks that of 90 % of the surface, which a cup's handle passes;
+/// this asks it of all of it, shape and paint: a pose turned by one is the same picture, as
+/// the spark-plug key's half-turn about its socket. BOP's `symmetries_discrete`, which synth
+/// writes so that eval scores such an object with ADI. Meshes tessellated unevenly (scans)
+/// find none.
+std::vector<NearSymmetry> exactSymmetries(const Mesh& mesh, float tolerance_m);
+
 /// Half-turns that nearly map the surface onto itself but not within the near-symmetry
 /// tolerance: the ones detection may still confuse with the pose (a carton turned end for
 /// end, 8 mm off; a jug turned flank for flank, 9 mm off). Half-turns about the same axes

@@ -299,6 +299,8 @@ struct BopModel {
   int obj_id = 0;
   const Mesh* mesh = nullptr;
   std::vector<ContinuousSymmetry> symmetries;
+  /// Turns that map the model onto itself, shape and colour (exactSymmetries), object frame.
+  std::vector<Pose> discrete_symmetries = {};
 };
 
 /// Writes the mesh in millimetres as a binary little-endian PLY (x y z, nx ny nz, and red
@@ -306,8 +308,8 @@ struct BopModel {
 /// InputError when the file exists and `overwrite` is false, or it cannot be written.
 void writePlyMillimetres(const Mesh& mesh, const std::string& path, bool overwrite);
 
-/// models_info.json: diameter, min_x.. and size_x.. in mm, and symmetries_continuous where
-/// the model has any.
+/// models_info.json: diameter, min_x.. and size_x.. in mm, and symmetries_continuous and
+/// symmetries_discrete (each a row-major 4x4 matrix, translation in mm) where the model has any.
 std::string modelsInfoJson(const std::vector<BopModel>& models);
 
 /// camera.json: cx, cy, depth_scale, fx, fy, height, width.

@@ -82,6 +82,19 @@ std::string modelsInfoJson(const std::vector<BopModel>& models) {
       }
       j["symmetries_continuous"] = sym;
     }
+    if (!m.discrete_symmetries.empty()) {
+      json sym = json::array();
+      for (const Pose& s : m.discrete_symmetries) {
+        json matrix = json::array();
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) matrix.push_back(round(s.R(r, c), 8));
+          matrix.push_back(round(s.t[r] * 1000.0, 6));
+        }
+        for (const double v : {0.0, 0.0, 0.0, 1.0}) matrix.push_back(v);
+        sym.push_back(matrix);
+      }
+      j["symmetries_discrete"] = sym;
+    }
     doc[std::to_string(m.obj_id)] = j;
   }
   return doc.dump(2) + "\n";

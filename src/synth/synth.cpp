@@ -16,6 +16,7 @@
 
 #include "synth/placement.hpp"
 #include "synth/scene.hpp"
+#include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/device.hpp"
 #include "vkpose/error.hpp"
@@ -535,6 +536,9 @@ SynthSummary generateSyntheticDataset(const GpuContext& ctx, const SynthParams& 
     BopModel bm{obj_id, &models[i], {}};
     if (std::find(p.symmetric.begin(), p.symmetric.end(), obj_id) != p.symmetric.end())
       bm.symmetries.push_back({Eigen::Vector3f::UnitZ(), models[i].bboxCentre()});
+    else  // a turn that gives the same picture (the key's half-turn) is no wrong pose: BOP's convention
+      for (const NearSymmetry& s : exactSymmetries(models[i], 0.002f * models[i].diameter))
+        bm.discrete_symmetries.push_back(s.transform());
     bop_models.push_back(bm);
     writePlyMillimetres(models[i], (out / "models" / fmt::format("obj_{:06d}.ply", obj_id)).string(), false);
   }

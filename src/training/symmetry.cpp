@@ -170,6 +170,28 @@ std::vector<NearSymmetry> findNearSymmetries(const Mesh& mesh, float tolerance_m
   return findTurns(mesh, {kAngles.begin(), kAngles.end()}, -1.f, tolerance_m, max_count);
 }
 
+std::vector<NearSymmetry> exactSymmetries(const Mesh& mesh, float tolerance_m) {
+  std::vector<NearSymmetry> exact;
+  if (mesh.vertices.empty() || !(tolerance_m > 0.f)) return exact;
+  const NearestNeighbours vertices(mesh.vertices, tolerance_m);
+  const bool coloured = mesh.colours.size() == mesh.vertices.size();
+  for (const NearSymmetry& s : findNearSymmetries(mesh, 0.01f * mesh.diameter)) {
+    const Pose turn = s.transform();
+    bool maps = true;
+    std::vector<int> near;
+    for (std::size_t i = 0; maps && i < mesh.vertices.size(); ++i) {
+      // Any vertex there of its colour: a painted mesh repeats a corner's vertex per face.
+      near.clear();
+      vertices.within(turn.R * mesh.vertices[i] + turn.t, tolerance_m, near);
+      maps = std::any_of(near.begin(), near.end(), [&](int j) {
+        return !coloured || (mesh.colours[i] - mesh.colours[static_cast<std::size_t>(j)]).cwiseAbs().maxCoeff() <= 0.1f;
+      });
+    }
+    if (maps) exact.push_back(s);
+  }
+  return exact;
+}
+
 std::optional<NearSymmetry> revolutionAxis(const std::vector<NearSymmetry>& symmetries) {
   // The search turns about a few fixed axes, so the turns of one axis share its direction and
   // point exactly (bank files keep them bit for bit); a little slack costs nothing.

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "mesh_support.hpp"
@@ -166,6 +167,33 @@ float lowestZ(const Mesh& m, const Pose& w) {
   float z = 1e9f;
   for (const auto& v : m.vertices) z = std::min(z, (w.R * v + w.t).z());
   return z;
+}
+
+// A model that a turn maps onto itself, shape and colour (the spark-plug key's half-turn), is
+// written with BOP's symmetries_discrete (row-major 4x4, translation in mm), so that eval
+// scores it with ADI; an L has none.
+TEST(SynthDataset, ExactSymmetriesAreWrittenAsBopsDiscreteOnes) {
+  const Mesh box = test::boxMesh({0.04f, 0.08f, 0.2f}, {0.f, 0.f, 0.1f});
+  BopModel symmetric{1, &box, {}};
+  for (const NearSymmetry& s : exactSymmetries(box, 1e-4f)) symmetric.discrete_symmetries.push_back(s.transform());
+  ASSERT_EQ(symmetric.discrete_symmetries.size(), 3u);
+  const Mesh l = test::lShapeMesh();
+  ASSERT_TRUE(exactSymmetries(l, 1e-4f).empty());
+  const BopModel plain{2, &l, {}};
+  const nlohmann::json info = nlohmann::json::parse(modelsInfoJson({symmetric, plain}));
+  ASSERT_EQ(info["1"]["symmetries_discrete"].size(), 3u);
+  for (const auto& m : info["1"]["symmetries_discrete"]) {
+    ASSERT_EQ(m.size(), 16u);
+    Pose t;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) t.R(r, c) = m[4 * r + c].get<float>();
+      t.t[r] = m[4 * r + 3].get<float>() * 1e-3f;
+    }
+    EXPECT_EQ(m[15].get<double>(), 1.0);
+    EXPECT_NEAR(t.R.determinant(), 1.f, 1e-5f);
+    EXPECT_LT((t.R * box.bboxCentre() + t.t - box.bboxCentre()).norm(), 1e-5f) << "the box stays where it is";
+  }
+  EXPECT_FALSE(info["2"].contains("symmetries_discrete"));
 }
 
 TEST(SynthPlacement, TableObjectsRestOnItAndNeverIntersect) {

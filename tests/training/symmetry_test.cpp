@@ -15,7 +15,7 @@
 #include "vkpose/bank.hpp"
 #include "vkpose/detector.hpp"
 #include "vkpose/error.hpp"
-#include "vkpose/bank.hpp"
+#include "vkpose/synth.hpp"
 
 namespace vkpose {
 namespace {
@@ -74,6 +74,24 @@ Mesh painted(const Mesh& mesh) {
   }
   finishMesh(out);
   return out;
+}
+
+// Exact symmetries (what synth writes as BOP's symmetries_discrete): turns that map every vertex
+// onto a vertex of its colour. The spark-plug key's half-turn about its socket; a plain box's
+// three half-turns, but none of the same box painted by face; none of an L.
+TEST(NearSymmetries, ExactSymmetriesAreTurnsThatGiveTheSamePicture) {
+  const Mesh key = partMeshes()[3];
+  ASSERT_EQ(key.name, "spark_plug_key");
+  const auto key_turns = exactSymmetries(key, 0.002f * key.diameter);
+  ASSERT_EQ(key_turns.size(), 1u);
+  EXPECT_TRUE(hasTurn(key_turns, Eigen::Vector3f::UnitZ(), 180.f)) << describe(key_turns[0]);
+  const Mesh box = test::boxMesh({0.04f, 0.08f, 0.2f});
+  EXPECT_EQ(exactSymmetries(box, 1e-4f).size(), 3u);
+  EXPECT_TRUE(exactSymmetries(painted(box), 1e-4f).empty());
+  EXPECT_TRUE(exactSymmetries(test::lShapeMesh(), 1e-4f).empty());
+  // The cup's turns about its axis fit 90 % of its surface; its handle is no symmetry.
+  const Mesh cup = test::meshOrStandIn("meshes/coffee_cup.stl", MeshUnits::Metres);
+  EXPECT_TRUE(exactSymmetries(cup, 0.002f * cup.diameter).empty());
 }
 
 /// The scene a camera sees of `mesh` at `pose`: its colours shaded by how squarely each face
