@@ -285,7 +285,7 @@ std::string poseTooUncertainToPick(const Detection& d, const PickParams& params)
   const bool colour_passed = colour_gate && d.colour_measured && d.colour_agreement >= params.min_colour_agreement;
   const float min_outline = params.min_outline_on_edges - (colour_passed ? params.colour_outline_allowance : 0.f);
   if (params.min_outline_on_edges > 0.f && d.outline_on_edges < min_outline)  // false for NaN: not measured
-    return fmt::format("the pose's outline lies on the image's edges for {:.0f} % of it (a pick needs {:.0f} %{}): too "
+    return fmt::format("the pose's outline lies on the image's edges for {:.1f} % of it (a pick needs {:.0f} %{}): too "
                        "uncertain a pose to grip, or something else of its size",
                        100.f * d.outline_on_edges, 100.f * min_outline, colour_passed ? ", its colour having passed" : "");
   if (colour_gate && d.colour_agreement < params.min_colour_agreement)

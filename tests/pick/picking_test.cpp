@@ -271,7 +271,7 @@ TEST(Picking, APoseWhoseOutlineStraysFromTheImagesEdgesIsNotPicked) {
   EXPECT_TRUE(plan.detections[0].valid.empty());
   ASSERT_EQ(plan.detections[0].refused.size(), 1u);
   EXPECT_EQ(plan.detections[0].refused[0].name, "side");
-  EXPECT_NE(plan.detections[0].refused[0].reason.find("outline lies on the image's edges for 30 %"), std::string::npos)
+  EXPECT_NE(plan.detections[0].refused[0].reason.find("outline lies on the image's edges for 30.0 %"), std::string::npos)
       << plan.detections[0].refused[0].reason;
   EXPECT_FALSE(plan.detections[1].valid.empty()) << "0.8 of its outline on edges";
   EXPECT_FALSE(plan.detections[2].valid.empty()) << "not measured: not held back";
@@ -319,9 +319,9 @@ TEST(Picking, AColourThatPassedLetsLessOfTheOutlineSitOnEdges) {
     return plan.detections.at(0).valid.empty() ? plan.detections.at(0).refused.at(0).reason : std::string();
   };
   EXPECT_EQ(refusal(coloured, {}), "") << "its colour was measured and passed: 40 % of the outline is enough";
-  EXPECT_NE(refusal(uncoloured, {}).find("for 45 % of it (a pick needs 50 %)"), std::string::npos)
+  EXPECT_NE(refusal(uncoloured, {}).find("for 45.0 % of it (a pick needs 50 %)"), std::string::npos)
       << "no colour measured (a mesh without colours): the whole gate";
-  EXPECT_NE(refusal(too_loose, {}).find("for 35 % of it (a pick needs 40 %, its colour having passed)"),
+  EXPECT_NE(refusal(too_loose, {}).find("for 35.0 % of it (a pick needs 40 %, its colour having passed)"),
             std::string::npos)
       << refusal(too_loose, {});
   PickParams no_allowance;
