@@ -394,10 +394,9 @@ float scaledOutlineSupport(const PointCloud& model, const PoseFrame& frame, cons
       PointCloud scaled(model.size());
       for (std::size_t i = 0; i < model.size(); ++i) scaled[i] = centre + d + s * (model[i] - centre);
       const auto outline = outlineSamples(scaled, frame.camera, frame.depth_m.size());
-      const float silhouette =
-          silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit);
-      best = std::max(
-          best, 0.5f * (contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump) + silhouette));
+      best = std::max(best, PoseEvidence::outlineSupport(
+                                contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump),
+                                silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit)));
     }
   }
   return best;

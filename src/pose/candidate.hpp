@@ -74,7 +74,11 @@ struct PoseEvidence {
   float scaled_outline_support = 0.f;
   float outline_on_edges = 0.f;  ///< outlineOnEdges: how closely the outline lies on the image's edges
   /// The outline's support at the part's own size: contour edges and silhouette, averaged.
-  float outlineSupport() const { return 0.5f * (contour_edges + silhouette_support); }
+  float outlineSupport() const { return outlineSupport(contour_edges, silhouette_support); }
+  /// The same average of any outline's two shares (the size probe's scaled models).
+  static float outlineSupport(float contour_edges, float silhouette_support) {
+    return 0.5f * (contour_edges + silhouette_support);
+  }
 };
 
 /// One start of stages 6-8 and what each stage found for it.
