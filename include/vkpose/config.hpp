@@ -89,7 +89,8 @@ struct NmsParams {
   /// hypothesis it suppressed whose gamma is at least this share of its own and whose best
   /// view is turned more than 30 degrees from the survivor's (runnersUp). A wrong view that
   /// fits a little better (a cluster on the edge of a box beside a lying cup, or a carton seen
-  /// from its other side) otherwise hides the right one a cell away. 0: none.
+  /// from its other side) otherwise hides the right one a cell away. A bank of several
+  /// resting poses brings one per resting pose (a cup seen into its opening). 0: none.
   float runner_up_share = 0.5f;
 };
 

@@ -254,7 +254,21 @@ std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std:
     const auto& m = h.members[static_cast<std::size_t>(h.best_member)];
     return banks[static_cast<std::size_t>(h.bank)].templates[static_cast<std::size_t>(m.template_index)].pose.R;
   };
-  std::vector<int> best(kept.size(), -1);
+  // A bank of several resting poses keeps one runner-up per resting pose (that of the
+  // hypothesis's best view). A cup seen straight into its opening lost to a view of its other
+  // end (its rim on the foot ring, 10 cm too far), and the one runner-up was a view of it
+  // lying: both fit the depth a little better than the right view, whose deep inside shifts
+  // with each degree of tilt between the viewpoints.
+  const auto restingPose = [&](const Hypothesis& h) {
+    const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
+    const auto& m = h.members[static_cast<std::size_t>(h.best_member)];
+    const int per_pose = std::max(1, bank.params.views.viewpoints);
+    return std::min(bank.templates[static_cast<std::size_t>(m.template_index)].viewpoint / per_pose,
+                    static_cast<int>(bank.params.views.other_ups.size()));
+  };
+  std::size_t slots = 1;
+  for (const TemplateBank& b : banks) slots = std::max(slots, 1 + b.params.views.other_ups.size());
+  std::vector<int> best(kept.size() * slots, -1);
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Hypothesis& h = all[i];
     if (h.best_member < 0 || isSmallPart(banks[static_cast<std::size_t>(h.bank)].diameter)) continue;
@@ -264,9 +278,10 @@ std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std:
       const Hypothesis& s = kept[k];
       if (s.bank != h.bank || s.best_member < 0 || !withinSuppressionRadius(h, s, banks, fx, params)) continue;
       const bool another_view = Eigen::AngleAxisf(bestView(h).transpose() * bestView(s)).angle() > min_angle;
+      int& slot = best[k * slots + static_cast<std::size_t>(restingPose(h))];
       if (another_view && h.score >= params.runner_up_share * s.score &&
-          (best[k] < 0 || h.score > all[static_cast<std::size_t>(best[k])].score))
-        best[k] = static_cast<int>(i);
+          (slot < 0 || h.score > all[static_cast<std::size_t>(slot)].score))
+        slot = static_cast<int>(i);
       break;
     }
   }

@@ -285,6 +285,44 @@ TEST(Nms, EachSurvivorBringsAlongItsBestRunnerUpOfAnotherView) {
   EXPECT_THROW(parseConfig(R"({"nms": {"runner_up_share": 1.5}})", "t"), InputError);
 }
 
+TEST(Nms, ABankOfSeveralRestingPosesKeepsARunnerUpForEachOfThem) {
+  // Two viewpoints per resting pose; the second resting pose is the object upside down. A cup
+  // seen into its opening fits the depth worse than a view of its foot or its side beside it.
+  TemplateBank object = fakeBank(3, {0.5f}, 0.2f);
+  object.params.views.viewpoints = 2;
+  object.params.views.other_ups = {-Eigen::Vector3f::UnitZ()};
+  object.templates[1].viewpoint = 1;  // resting pose 0, turned 90 degrees
+  object.templates[1].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI) / 2, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  object.templates[2].viewpoint = 2;  // resting pose 1, upside down
+  object.templates[2].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI), Eigen::Vector3f::UnitX()).toRotationMatrix();
+  const auto showing = [](Hypothesis h, int view) {
+    h.members = {ClusterMember{}};
+    h.members[0].template_index = view;
+    h.best_member = 0;
+    return h;
+  };
+  NmsParams p;
+  p.across_objects = false;
+  const std::vector<Hypothesis> all{showing(scored(100, 100, 0.9f), 0),  // the survivor
+                                    showing(scored(110, 100, 0.7f), 1),  // its own resting pose's runner-up
+                                    showing(scored(120, 100, 0.6f), 1),  // less
+                                    showing(scored(90, 100, 0.5f), 2),   // the other resting pose's
+                                    showing(scored(95, 100, 0.4f), 2)};  // under half the survivor's
+  std::vector<TemplateBank> banks{object};
+  const auto kept = suppressNonMaxima(all, banks, 500, p);
+  ASSERT_EQ(kept.size(), 1u);
+  auto ups = runnersUp(all, kept, banks, 500, p);
+  ASSERT_EQ(ups.size(), 2u);
+  EXPECT_FLOAT_EQ(ups[0].score, 0.7f);
+  EXPECT_FLOAT_EQ(ups[1].score, 0.5f);
+  // One resting pose (the same templates, read as one hemisphere): one runner-up, the best.
+  banks[0].params.views.viewpoints = 3;
+  banks[0].params.views.other_ups.clear();
+  ups = runnersUp(all, kept, banks, 500, p);
+  ASSERT_EQ(ups.size(), 1u);
+  EXPECT_FLOAT_EQ(ups[0].score, 0.7f);
+}
+
 TEST(ViewingRay, TurnsTheOpticalAxisOntoThePixelsRay) {
   Camera cam;
   for (auto [x, y] : {std::pair{0.f, 0.f}, {639.f, 479.f}, {cam.cx, cam.cy}, {100.f, 400.f}}) {
