@@ -440,10 +440,15 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
       continue;
     }
     const NearestNeighbours own(parts[i].points, 0.005f);
+    // The other detections a gripper must miss: those sure enough to be picked themselves. A
+    // pose too uncertain to grip is as uncertain an obstacle (most often a look-alike on a
+    // box beside the part, which blocked the part's side grasp); what the scene shows of it
+    // is still in the scene's points, which the gripper must miss too.
     std::vector<const std::vector<Eigen::Vector3f>*> others;
     std::vector<std::size_t> other_index;
     for (std::size_t j = 0; j < parts.size(); ++j)
-      if (j != i) others.push_back(&parts[j].points), other_index.push_back(j);
+      if (j != i && poseTooUncertainToPick(detections[j], params).empty())
+        others.push_back(&parts[j].points), other_index.push_back(j);
 
     // Copies of each named grasp, least tilted first; the first that hits nothing is valid.
     std::map<std::string, std::vector<PlacedGrasp>> copies;

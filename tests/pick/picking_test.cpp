@@ -210,6 +210,16 @@ TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
       << blocked.detections[0].refused[0].reason;
   ASSERT_EQ(blocked.picks.size(), 1u);  // the one on top is picked
   EXPECT_EQ(blocked.picks[0].detection, 1);
+  // The one on top with a pose too uncertain to pick (a third of its outline on the image's
+  // edges) blocks nothing: it is as uncertain an obstacle (what the depth image shows of it
+  // still would be, as below).
+  Detection doubtful = detectionAt(above);
+  doubtful.outline_on_edges = 0.3f;
+  const PickPlan past = planPicks({detectionAt(lyingCan(0.f)), doubtful}, {bank}, {grasps}, cv::Mat(), camera(),
+                                  std::nullopt, params);
+  ASSERT_EQ(past.picks.size(), 1u);
+  EXPECT_EQ(past.picks[0].detection, 0);
+  EXPECT_TRUE(past.detections[1].valid.empty());
   // Scene points in the way (a board 5 cm above the can, seen in the depth image) refuse it.
   cv::Mat depth(480, 640, CV_32F, cv::Scalar(0.70f));
   const PickPlan board = planPicks({detectionAt(lyingCan(0.f))}, {bank}, {grasps}, depth, camera(), std::nullopt, params);
