@@ -239,6 +239,14 @@ TEST(Nms, KeepsASmallPartsNeighbouringViews) {
   EXPECT_EQ(suppressNonMaxima(hyps, part, 500, p).size(), 1u);
 }
 
+// `h` as a cluster of one member, template `view`, that is its best.
+Hypothesis showing(Hypothesis h, int view) {
+  h.members = {ClusterMember{}};
+  h.members[0].template_index = view;
+  h.best_member = 0;
+  return h;
+}
+
 // A wrong view that fits a little better hides the right one a cell away (a cluster on the
 // edge of a box beside a lying cup): each survivor of an object of 10 cm and more brings along
 // the best hypothesis it suppressed that shows another view and fits at least half as well.
@@ -247,12 +255,6 @@ TEST(Nms, EachSurvivorBringsAlongItsBestRunnerUpOfAnotherView) {
   TemplateBank object = fakeBank(3, {0.5f}, 0.2f);
   object.templates[1].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI) / 2, Eigen::Vector3f::UnitX()).toRotationMatrix();
   object.templates[2].pose.R = Eigen::AngleAxisf(0.1745f, Eigen::Vector3f::UnitX()).toRotationMatrix();
-  const auto showing = [](Hypothesis h, int view) {
-    h.members = {ClusterMember{}};
-    h.members[0].template_index = view;
-    h.best_member = 0;
-    return h;
-  };
   NmsParams p;
   p.across_objects = false;
   ASSERT_FLOAT_EQ(p.runner_up_share, 0.5f);
@@ -295,12 +297,6 @@ TEST(Nms, ABankOfSeveralRestingPosesKeepsARunnerUpForEachOfThem) {
   object.templates[1].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI) / 2, Eigen::Vector3f::UnitX()).toRotationMatrix();
   object.templates[2].viewpoint = 2;  // resting pose 1, upside down
   object.templates[2].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI), Eigen::Vector3f::UnitX()).toRotationMatrix();
-  const auto showing = [](Hypothesis h, int view) {
-    h.members = {ClusterMember{}};
-    h.members[0].template_index = view;
-    h.best_member = 0;
-    return h;
-  };
   NmsParams p;
   p.across_objects = false;
   const std::vector<Hypothesis> all{showing(scored(100, 100, 0.9f), 0),  // the survivor
