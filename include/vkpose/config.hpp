@@ -92,6 +92,12 @@ struct NmsParams {
   /// from its other side) otherwise hides the right one a cell away. A bank of several
   /// resting poses brings one per resting pose (a cup seen into its opening). 0: none.
   float runner_up_share = 0.5f;
+  /// The share a runner-up of another resting pose than the survivor's needs instead. A cup
+  /// seen straight into its opening scores low (its deep inside shifts against the rim
+  /// between viewpoints) beside a view of its other end: 0.48 and 0.49 of that one's gamma on
+  /// two bins. Lower than runner_up_share, since another resting pose is another side of the
+  /// object, not a look-alike view of the same side.
+  float resting_pose_runner_up_share = 0.4f;
 };
 
 struct InitialPoseParams {

@@ -41,6 +41,7 @@ std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
       {"nms", "template_weight", "parts under 10 cm: rank by gamma * (templates in the cluster)^w (0: gamma alone)", &p.nms.template_weight, closed(0, 4)},
       {"nms", "small_part_radius_fraction", "parts under 10 cm, with poses: suppression radius within the part, share of its projected diameter", &p.nms.small_part_radius_fraction, above(0)},
       {"nms", "runner_up_share", "objects of 10 cm and more, with poses: each survivor's best suppressed hypothesis of another view (for a bank of several resting poses, of each resting pose) also gets a pose when its gamma is at least this share of the survivor's (0: none)", &p.nms.runner_up_share, closed(0, 1)},
+      {"nms", "resting_pose_runner_up_share", "the share a runner-up of another resting pose than the survivor's needs instead (banks of several resting poses)", &p.nms.resting_pose_runner_up_share, closed(0, 1)},
       {"nms", "across_objects", "suppress across objects too (without poses)", &p.nms.across_objects},
       {"detector", "estimate_poses", "run stages 6-8 (false: stop after NMS and report the best template's pose, unverified)", &p.estimate_poses, {}, "!--no-pose"},
       {"detector", "min_score", "without poses: smallest cluster score gamma, 0..1", &p.min_score, closed(0, 1), "--min-score"},

@@ -278,8 +278,10 @@ std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std:
       const Hypothesis& s = kept[k];
       if (s.bank != h.bank || s.best_member < 0 || !withinSuppressionRadius(h, s, banks, fx, params)) continue;
       const bool another_view = Eigen::AngleAxisf(bestView(h).transpose() * bestView(s)).angle() > min_angle;
-      int& slot = best[k * slots + static_cast<std::size_t>(restingPose(h))];
-      if (another_view && h.score >= params.runner_up_share * s.score &&
+      const int pose = restingPose(h);
+      int& slot = best[k * slots + static_cast<std::size_t>(pose)];
+      const float share = pose == restingPose(s) ? params.runner_up_share : params.resting_pose_runner_up_share;
+      if (another_view && h.score >= share * s.score &&
           (slot < 0 || h.score > all[static_cast<std::size_t>(slot)].score))
         slot = static_cast<int>(i);
       break;

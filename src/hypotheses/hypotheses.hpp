@@ -94,8 +94,9 @@ Eigen::Matrix3f viewingRayRotation(float x, float y, const Camera& camera);
 /// survivors, best first, of objects of 10 cm and more) the best hypothesis of `all` (those
 /// NMS ran on) that it suppressed, where that one's gamma is at least runner_up_share of the
 /// survivor's and its best view is turned more than 30 degrees from the survivor's; for a bank
-/// of several resting poses, one such hypothesis per resting pose of its best view. In the
-/// survivors' order; empty when the share is 0.
+/// of several resting poses, one such hypothesis per resting pose of its best view, those of
+/// another resting pose than the survivor's at resting_pose_runner_up_share. In the
+/// survivors' order; empty when runner_up_share is 0.
 std::vector<Hypothesis> runnersUp(const std::vector<Hypothesis>& all, const std::vector<Hypothesis>& kept,
                                   const std::vector<TemplateBank>& banks, double fx, const NmsParams& params);
 

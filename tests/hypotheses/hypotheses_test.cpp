@@ -299,18 +299,27 @@ TEST(Nms, ABankOfSeveralRestingPosesKeepsARunnerUpForEachOfThem) {
   object.templates[2].pose.R = Eigen::AngleAxisf(static_cast<float>(M_PI), Eigen::Vector3f::UnitX()).toRotationMatrix();
   NmsParams p;
   p.across_objects = false;
-  const std::vector<Hypothesis> all{showing(scored(100, 100, 0.9f), 0),  // the survivor
-                                    showing(scored(110, 100, 0.7f), 1),  // its own resting pose's runner-up
-                                    showing(scored(120, 100, 0.6f), 1),  // less
-                                    showing(scored(90, 100, 0.5f), 2),   // the other resting pose's
-                                    showing(scored(95, 100, 0.4f), 2)};  // under half the survivor's
+  ASSERT_FLOAT_EQ(p.resting_pose_runner_up_share, 0.4f);
+  const std::vector<Hypothesis> all{showing(scored(100, 100, 0.9f), 0),   // the survivor
+                                    showing(scored(110, 100, 0.7f), 1),   // its own resting pose's runner-up
+                                    showing(scored(120, 100, 0.6f), 1),   // less
+                                    showing(scored(105, 100, 0.38f), 1),  // under half: not of its own pose
+                                    showing(scored(90, 100, 0.4f), 2),    // the other resting pose's: 0.44 is enough
+                                    showing(scored(95, 100, 0.3f), 2)};   // less, and under 0.4 of the survivor's
   std::vector<TemplateBank> banks{object};
   const auto kept = suppressNonMaxima(all, banks, 500, p);
   ASSERT_EQ(kept.size(), 1u);
   auto ups = runnersUp(all, kept, banks, 500, p);
   ASSERT_EQ(ups.size(), 2u);
   EXPECT_FLOAT_EQ(ups[0].score, 0.7f);
-  EXPECT_FLOAT_EQ(ups[1].score, 0.5f);
+  EXPECT_FLOAT_EQ(ups[1].score, 0.4f);
+  // Asked for half, as for the survivor's own resting pose, the other one brings none.
+  p.resting_pose_runner_up_share = 0.5f;
+  ups = runnersUp(all, kept, banks, 500, p);
+  ASSERT_EQ(ups.size(), 1u);
+  EXPECT_FLOAT_EQ(ups[0].score, 0.7f);
+  p.resting_pose_runner_up_share = 0.4f;
+  EXPECT_THROW(parseConfig(R"({"nms": {"resting_pose_runner_up_share": -0.1}})", "t"), InputError);
   // One resting pose (the same templates, read as one hemisphere): one runner-up, the best.
   banks[0].params.views.viewpoints = 3;
   banks[0].params.views.other_ups.clear();
