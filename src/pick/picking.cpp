@@ -428,11 +428,16 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
   float z_near = 1e9f, z_far = 0.f;
   for (const PlacedPart& p : parts) z_near = std::min(z_near, p.centre.z()), z_far = std::max(z_far, p.centre.z());
 
+  // Why each detection is too uncertain to pick ("" when it is not): it is then neither picked
+  // nor an obstacle to another's grasp.
+  std::vector<std::string> uncertain;
+  for (const Detection& d : detections) uncertain.push_back(poseTooUncertainToPick(d, params));
+
   for (std::size_t i = 0; i < detections.size(); ++i) {
     const Detection& d = detections[i];
     const auto b = static_cast<std::size_t>(d.bank);
     if (b >= grasps.size() || grasps[b].empty()) continue;
-    if (const std::string why = poseTooUncertainToPick(d, params); !why.empty()) {
+    if (const std::string& why = uncertain[i]; !why.empty()) {
       std::vector<std::string> names;
       for (const Grasp& g : grasps[b])
         if (std::find(names.begin(), names.end(), g.name) == names.end()) names.push_back(g.name);
@@ -447,7 +452,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
     std::vector<const std::vector<Eigen::Vector3f>*> others;
     std::vector<std::size_t> other_index;
     for (std::size_t j = 0; j < parts.size(); ++j)
-      if (j != i && poseTooUncertainToPick(detections[j], params).empty())
+      if (j != i && uncertain[j].empty())
         others.push_back(&parts[j].points), other_index.push_back(j);
 
     // Copies of each named grasp, least tilted first; the first that hits nothing is valid.
