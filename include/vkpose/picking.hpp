@@ -144,7 +144,9 @@ struct PlacedGrasp {
 
 struct RefusedGrasp {
   std::string name;
-  std::string reason;  ///< e.g. "hits the bin's wall (+x)", "approach tilted 62 degrees (at most 45)"
+  /// e.g. "hits the bin's wall (+x)", "approach tilted 62 degrees (at most 45)", "hits detection 2
+  /// (obj_000001)" (detections numbered from 1, as the detection table and the overlay label them)
+  std::string reason;
 };
 
 /// What became of one detection's grasps: the valid ones (best first: priority, then tilt) and

@@ -388,7 +388,8 @@ std::string refusal(PlacedGrasp& p, const Grasp& g, const GraspSurroundings& at)
   const auto [hit, nearest] = pointCollision(swept, p.pose, at.others, params.clearance_m);
   if (hit >= 0) {
     const std::size_t other = at.other_index[static_cast<std::size_t>(hit)];
-    return fmt::format("hits detection {} ({})", other, at.detections[other].object);
+    // Numbered from 1, as the detection table and the overlay label them.
+    return fmt::format("hits detection {} ({})", other + 1, at.detections[other].object);
   }
   const SceneClearance scene =
       sceneClearance(swept, p.pose, at.depth_m, at.camera, at.own, params.part_tolerance_m, params.clearance_m);
@@ -558,7 +559,7 @@ std::string firstPickProblem(const PickPlan& plan, const std::vector<Detection>&
     others.push_back(std::move(part.points));
     names.push_back(fmt::format("true instance {} ({})", k, tb.object));
   }
-  if (matched < 0) return fmt::format("detection {} ({}) is no true instance", pick.detection, d.object);
+  if (matched < 0) return fmt::format("detection {} ({}) is no true instance", pick.detection + 1, d.object);
   others.erase(others.begin() + matched);
   names.erase(names.begin() + matched);
   const std::string hit = gripperCollision(pick.grasp.source, pick.grasp.pose, bin, others, names);

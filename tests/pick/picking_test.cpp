@@ -206,7 +206,7 @@ TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
                                      camera(), std::nullopt, params);
   ASSERT_EQ(blocked.detections.size(), 2u);
   EXPECT_TRUE(blocked.detections[0].valid.empty());
-  EXPECT_NE(blocked.detections[0].refused[0].reason.find("hits detection 1"), std::string::npos)
+  EXPECT_NE(blocked.detections[0].refused[0].reason.find("hits detection 2"), std::string::npos)
       << blocked.detections[0].refused[0].reason;
   ASSERT_EQ(blocked.picks.size(), 1u);  // the one on top is picked
   EXPECT_EQ(blocked.picks[0].detection, 1);
