@@ -63,7 +63,7 @@ GraspSet loadGrasps(const std::string& path);
 /// object's symmetries (expandBySymmetry); banks without a file get none. InputError for a
 /// file of an object no bank is for (the banks' objects named).
 std::vector<std::vector<Grasp>> graspsForBanks(const std::vector<std::string>& files,
-                                               const std::vector<TemplateBank>& banks, int symmetry_steps = 36);
+                                               const std::vector<TemplateBank>& banks, int symmetry_steps = 144);
 
 /// Grasps for a part without a grasp file of its own: a suction cup (`suction_radius_m`, on a
 /// gripper `gripper_radius_m` wide) on the middle of each face of the mesh's box, approaching
@@ -108,7 +108,9 @@ struct PickParams {
   /// Scene points within this of the part's own surface are the part (the gripper holds it).
   float part_tolerance_m = 0.005f;
   float clearance_m = 0.02f;  ///< free space around a grasp counts up to this
-  int symmetry_steps = 36;    ///< copies of a grasp about a symmetric object's axis
+  /// Copies of a grasp about a symmetric object's axis: every 2.5 degrees, since a part beside
+  /// a neighbour or a wall can leave a gap of a few degrees that 10-degree steps miss.
+  int symmetry_steps = 144;
   /// A detection whose outline lies on the image's edges less than this (its
   /// outline_on_edges) is not picked: a grasp needs a pose that sits on the part, and a
   /// look-alike of the part's size (a cylinder taken for a cup) strays from the edges where

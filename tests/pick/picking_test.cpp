@@ -176,6 +176,29 @@ TEST(Picking, TiltIsMeasuredDownIntoTheBinWhereThereIsOne) {
   EXPECT_NE(from_camera.detections[0].refused[0].reason.find("tilted 30 degrees"), std::string::npos);
 }
 
+TEST(Picking, ANarrowWindowOfApproachesIsFoundWhateverAngleThePartLiesAt) {
+  // A can lying turned 5 degrees about its axis, and approaches allowed within 2 degrees of
+  // the camera's axis: every copy of its side grasp 10 degrees apart is 5 degrees off, so
+  // copies every 10 degrees refuse it; the default copies (every 2.5 degrees) find the one
+  // straight down. A neighbour or a wall beside a part leaves such gaps.
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> side = parseGrasps(kSideGrasp, "can.json").grasps;
+  PickParams params;
+  params.max_tilt_deg = 2.f;
+  EXPECT_GE(params.symmetry_steps, 144);
+  const Detection can = detectionAt(lyingCan(5.f));
+  const PickPlan coarse =
+      planPicks({can}, {bank}, {expandBySymmetry(side, bank, 36)}, cv::Mat(), camera(), std::nullopt, params);
+  EXPECT_TRUE(coarse.picks.empty());
+  ASSERT_EQ(coarse.detections[0].refused.size(), 1u);
+  EXPECT_NE(coarse.detections[0].refused[0].reason.find("tilted 5 degrees"), std::string::npos)
+      << coarse.detections[0].refused[0].reason;
+  const PickPlan fine = planPicks({can}, {bank}, {expandBySymmetry(side, bank, params.symmetry_steps)}, cv::Mat(),
+                                  camera(), std::nullopt, params);
+  ASSERT_EQ(fine.picks.size(), 1u);
+  EXPECT_LT(fine.picks[0].grasp.tilt_deg, 0.1f);
+}
+
 TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
