@@ -108,6 +108,10 @@ struct PickParams {
   /// Scene points within this of the part's own surface are the part (the gripper holds it).
   float part_tolerance_m = 0.005f;
   float clearance_m = 0.02f;  ///< free space around a grasp counts up to this
+  /// A grasp that passes nearer than this to another detection's surface hits it: a
+  /// neighbour's pose is a few millimetres off (more where it is partly hidden). The scene's
+  /// points need none: they are where the camera saw them.
+  float neighbour_margin_m = 0.003f;
   /// Copies of a grasp about a symmetric object's axis: every 2.5 degrees, since a part beside
   /// a neighbour or a wall can leave a gap of a few degrees that 10-degree steps miss.
   int symmetry_steps = 144;
@@ -151,7 +155,8 @@ struct RefusedGrasp {
   std::string reason;
 };
 
-/// What became of one detection's grasps: the valid ones (best first: priority, then tilt) and
+/// What became of one detection's grasps: the valid ones (one copy of each named grasp, the one
+/// whose approach the combined rank values most; best first: priority, then tilt) and
 /// each refused grasp with the reason of its least tilted copy.
 struct DetectionGrasps {
   std::vector<PlacedGrasp> valid;

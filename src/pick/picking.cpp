@@ -245,10 +245,11 @@ SceneClearance sceneClearance(const SweptGripper& swept, const Pose& camera_T_gr
   return out;
 }
 
-/// The first of `obstacles` whose points the swept gripper holds, and the nearest point's
-/// distance to it (up to `clearance`).
+/// The first of `obstacles` with a point within `margin` of the swept gripper (inside it at
+/// 0), and the nearest point's distance to it (up to `clearance`).
 std::pair<int, float> pointCollision(const SweptGripper& swept, const Pose& camera_T_gripper,
-                                     const std::vector<const std::vector<Eigen::Vector3f>*>& obstacles, float clearance) {
+                                     const std::vector<const std::vector<Eigen::Vector3f>*>& obstacles, float clearance,
+                                     float margin = 0.f) {
   const Pose gripper_T_camera = invert(camera_T_gripper);
   const auto [centre_g, radius] = swept.sphere();
   const Eigen::Vector3f c = camera_T_gripper.R * centre_g + camera_T_gripper.t;
@@ -257,7 +258,7 @@ std::pair<int, float> pointCollision(const SweptGripper& swept, const Pose& came
     for (const Eigen::Vector3f& p : *obstacles[k]) {
       if ((p - c).squaredNorm() > (radius + clearance) * (radius + clearance)) continue;
       const float d = swept.distance(inGripper(gripper_T_camera, p));
-      if (d == 0.f) return {static_cast<int>(k), 0.f};
+      if (d <= margin) return {static_cast<int>(k), d};
       nearest = std::min(nearest, d);
     }
   return {-1, nearest};
@@ -294,6 +295,22 @@ std::string poseTooUncertainToPick(const Detection& d, const PickParams& params)
   return {};
 }
 
+/// The combined rank's weights of a grasp's reach and free space (docs/picking.md).
+constexpr float kReachWeight = 0.15f, kFreeSpaceWeight = 0.1f;
+
+float reachOf(const PlacedGrasp& g, const PickParams& params) {
+  return std::clamp(1.f - g.tilt_deg / params.max_tilt_deg, 0.f, 1.f);
+}
+
+float freeSpaceOf(const PlacedGrasp& g, const PickParams& params) {
+  return params.clearance_m > 0.f ? std::clamp(g.clearance_m / params.clearance_m, 0.f, 1.f) : 1.f;
+}
+
+/// What the combined rank gives a grasp's approach: its reach and free-space terms.
+float approachValue(const PlacedGrasp& g, const PickParams& params) {
+  return kReachWeight * reachOf(g, params) + kFreeSpaceWeight * freeSpaceOf(g, params);
+}
+
 float rankOf(const Pick& p, PickOrder order) {
   switch (order) {
     case PickOrder::Height: return p.height;
@@ -301,7 +318,7 @@ float rankOf(const Pick& p, PickOrder order) {
     case PickOrder::Visible: return p.visible;
     case PickOrder::Combined: break;
   }
-  return 0.3f * p.score + 0.25f * p.height + 0.2f * p.visible + 0.15f * p.reach + 0.1f * p.free;
+  return 0.3f * p.score + 0.25f * p.height + 0.2f * p.visible + kReachWeight * p.reach + kFreeSpaceWeight * p.free;
 }
 }  // namespace
 
@@ -385,7 +402,7 @@ std::string refusal(PlacedGrasp& p, const Grasp& g, const GraspSurroundings& at)
     std::string why = binCollision(swept, p.pose, *at.bin);
     if (!why.empty()) return why;
   }
-  const auto [hit, nearest] = pointCollision(swept, p.pose, at.others, params.clearance_m);
+  const auto [hit, nearest] = pointCollision(swept, p.pose, at.others, params.clearance_m, params.neighbour_margin_m);
   if (hit >= 0) {
     const std::size_t other = at.other_index[static_cast<std::size_t>(hit)];
     // Numbered from 1, as the detection table and the overlay label them.
@@ -456,7 +473,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
       if (j != i && uncertain[j].empty())
         others.push_back(&parts[j].points), other_index.push_back(j);
 
-    // Copies of each named grasp, least tilted first; the first that hits nothing is valid.
+    // Copies of each named grasp, least tilted first (the valid one chosen below).
     std::map<std::string, std::vector<PlacedGrasp>> copies;
     std::map<std::string, std::vector<const Grasp*>> sources;
     std::vector<std::string> order;
@@ -471,18 +488,26 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
       for (std::size_t k = 0; k < idx.size(); ++k) idx[k] = k;
       std::stable_sort(idx.begin(), idx.end(),
                        [&](std::size_t x, std::size_t y) { return copies[name][x].tilt_deg < copies[name][y].tilt_deg; });
+      // Of the copies that hit nothing, the one whose approach the combined rank values most
+      // (reach and free space): a copy that grazes a neighbour gives way to one a few degrees
+      // more tilted with room around it, since poses and depth are millimetres off and the
+      // neighbour's far side is not seen. Copies come least tilted first, so one with the full
+      // clearance cannot be beaten by a later one.
+      std::optional<PlacedGrasp> best;
+      float best_value = -1.f;
       std::string first_reason;
       for (const std::size_t k : idx) {
         PlacedGrasp p = copies[name][k];
         const std::string why = refusal(p, *sources[name][k], {detections, others, other_index, own, depth_m, camera, bin, params});
-        if (why.empty()) {
-          out.valid.push_back(p);
-          first_reason.clear();
-          break;
+        if (!why.empty()) {
+          if (first_reason.empty()) first_reason = why;
+          continue;
         }
-        if (first_reason.empty()) first_reason = why;
+        if (const float value = approachValue(p, params); value > best_value) best = p, best_value = value;
+        if (p.clearance_m >= params.clearance_m) break;
       }
-      if (!first_reason.empty()) out.refused.push_back({name, first_reason});
+      if (best) out.valid.push_back(*best);
+      else out.refused.push_back({name, first_reason});
     }
     std::stable_sort(out.valid.begin(), out.valid.end(), [](const PlacedGrasp& x, const PlacedGrasp& y) {
       return x.priority != y.priority ? x.priority > y.priority : x.tilt_deg < y.tilt_deg;
@@ -500,8 +525,8 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
     } else {
       pick.height = z_far > z_near ? (z_far - parts[i].centre.z()) / (z_far - z_near) : 1.f;
     }
-    pick.reach = std::clamp(1.f - pick.grasp.tilt_deg / params.max_tilt_deg, 0.f, 1.f);
-    pick.free = params.clearance_m > 0.f ? std::clamp(pick.grasp.clearance_m / params.clearance_m, 0.f, 1.f) : 1.f;
+    pick.reach = reachOf(pick.grasp, params);
+    pick.free = freeSpaceOf(pick.grasp, params);
     pick.rank = rankOf(pick, params.order);
     plan.picks.push_back(pick);
   }

@@ -199,6 +199,35 @@ TEST(Picking, ANarrowWindowOfApproachesIsFoundWhateverAngleThePartLiesAt) {
   EXPECT_LT(fine.picks[0].grasp.tilt_deg, 0.1f);
 }
 
+TEST(Picking, AGraspKeepsItsDistanceFromANeighbour) {
+  // A can lying on its side, and a second one lying beside and above it (centre 56 mm across
+  // and 80 mm nearer the camera): the suction gripper (15 mm radius) coming straight down
+  // onto the first passes 1 mm from the second.
+  const TemplateBank bank = canBank();
+  const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 144);
+  Pose neighbour = lyingCan(0.f);
+  neighbour.t = {0.f, 0.056f, 0.72f};
+  const std::vector<Detection> cans = {detectionAt(lyingCan(0.f)), detectionAt(neighbour)};
+  PickParams params;
+  params.max_tilt_deg = 2.f;  // only the straight approach
+  const PickPlan close = planPicks(cans, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, params);
+  EXPECT_TRUE(close.detections[0].valid.empty());  // within the 3 mm a neighbour's pose may be off
+  ASSERT_EQ(close.detections[0].refused.size(), 1u);
+  EXPECT_NE(close.detections[0].refused[0].reason.find("hits detection 2"), std::string::npos)
+      << close.detections[0].refused[0].reason;
+  params.neighbour_margin_m = 0.f;
+  const PickPlan grazing = planPicks(cans, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, params);
+  ASSERT_EQ(grazing.detections[0].valid.size(), 1u);
+  EXPECT_LT(grazing.detections[0].valid[0].clearance_m, 0.003f);
+  // Allowed 45 degrees, the copy chosen is not the least tilted but one turned away from the
+  // neighbour, with room around it.
+  params = PickParams{};
+  const PickPlan roomy = planPicks(cans, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, params);
+  ASSERT_EQ(roomy.detections[0].valid.size(), 1u);
+  EXPECT_GT(roomy.detections[0].valid[0].tilt_deg, 2.f);
+  EXPECT_GT(roomy.detections[0].valid[0].clearance_m, 0.005f);
+}
+
 TEST(Picking, GraspsThatHitTheBinOrANeighbourAreRefusedWithTheReason) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
@@ -296,7 +325,9 @@ TEST(Picking, TheFirstPickIsCheckedAgainstTheTruth) {
 TEST(Picking, APoseWhoseOutlineStraysFromTheImagesEdgesIsNotPicked) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
-  Detection loose = detectionAt(lyingCan(0.f)), firm = loose, unmeasured = loose;
+  // Three cans side by side along their axes, 20 cm apart.
+  Detection loose = detectionAt(lyingCan(0.f, -0.2f)), firm = detectionAt(lyingCan(0.f)),
+            unmeasured = detectionAt(lyingCan(0.f, 0.2f));
   loose.outline_on_edges = 0.3f;
   firm.outline_on_edges = 0.8f;
   const PickPlan plan = planPicks({loose, firm, unmeasured}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, {});
@@ -317,7 +348,8 @@ TEST(Picking, APoseWhoseColourDisagreesWithItsModelIsNotPicked) {
   const TemplateBank bank = canBank();
   const std::vector<Grasp> grasps = expandBySymmetry(parseGrasps(kSideGrasp, "can.json").grasps, bank, 36);
   // A cylinder of another colour taken for the can: its outline fits, its colour does not.
-  Detection other = detectionAt(lyingCan(0.f)), same = other, uncoloured = other;
+  Detection other = detectionAt(lyingCan(0.f, -0.2f)), same = detectionAt(lyingCan(0.f)),
+            uncoloured = detectionAt(lyingCan(0.f, 0.2f));
   other.outline_on_edges = same.outline_on_edges = 0.9f;
   other.colour_agreement = 0.3f;
   same.colour_agreement = 0.85f;  // uncoloured keeps 1: a mesh without colours measures nothing
