@@ -59,11 +59,16 @@ struct GraspSet {
 GraspSet parseGrasps(const std::string& json, const std::string& source);
 GraspSet loadGrasps(const std::string& path);
 
+/// Copies of a grasp about a symmetric object's axis by default: every 2.5 degrees, since a
+/// part beside a neighbour or a wall can leave a gap of a few degrees that 10-degree steps miss.
+inline constexpr int kGraspSymmetrySteps = 144;
+
 /// The grasp files' grasps for each bank (by index, in the banks' order), each expanded by its
 /// object's symmetries (expandBySymmetry); banks without a file get none. InputError for a
 /// file of an object no bank is for (the banks' objects named).
 std::vector<std::vector<Grasp>> graspsForBanks(const std::vector<std::string>& files,
-                                               const std::vector<TemplateBank>& banks, int symmetry_steps = 144);
+                                               const std::vector<TemplateBank>& banks,
+                                               int symmetry_steps = kGraspSymmetrySteps);
 
 /// Grasps for a part without a grasp file of its own: a suction cup (`suction_radius_m`, on a
 /// gripper `gripper_radius_m` wide) on the middle of each face of the mesh's box, approaching
@@ -112,9 +117,7 @@ struct PickParams {
   /// neighbour's pose is a few millimetres off (more where it is partly hidden). The scene's
   /// points need none: they are where the camera saw them.
   float neighbour_margin_m = 0.003f;
-  /// Copies of a grasp about a symmetric object's axis: every 2.5 degrees, since a part beside
-  /// a neighbour or a wall can leave a gap of a few degrees that 10-degree steps miss.
-  int symmetry_steps = 144;
+  int symmetry_steps = kGraspSymmetrySteps;  ///< copies of a grasp about a symmetric object's axis
   /// A detection whose outline lies on the image's edges less than this (its
   /// outline_on_edges) is not picked: a grasp needs a pose that sits on the part, and a
   /// look-alike of the part's size (a cylinder taken for a cup) strays from the edges where
