@@ -501,6 +501,7 @@ PickPlan planPicks(const std::vector<Detection>& detections, const std::vector<T
         const std::string why = refusal(p, *sources[name][k], {detections, others, other_index, own, depth_m, camera, bin, params});
         if (!why.empty()) {
           if (first_reason.empty()) first_reason = why;
+          if (p.tilt_deg > params.max_tilt_deg) break;  // and so is every copy after it
           continue;
         }
         if (const float value = approachValue(p, params); value > best_value) best = p, best_value = value;
