@@ -665,8 +665,9 @@ bin file. order: combined, height, score or visible. max_tilt: degrees from appr
 min_outline_on_edges: a detection is picked only when this share of its outline lies on the
 image's edges (Detection.outline_on_edges; 0: off). min_colour_agreement: and only when its colour
 agrees with its model's this much (Detection.colour_agreement, where the mesh has colours; 0: off).
-colour_outline_allowance: min_outline_on_edges asks this much less of a detection whose colour was
-measured (Detection.colour_measured) and passed min_colour_agreement.)");
+colour_outline_allowance: min_outline_on_edges asks up to this much less of a detection whose colour
+was measured (Detection.colour_measured) and passed min_colour_agreement: all of it at an agreement
+of 1, none at 0.6, linear between.)");
 }
 
 }  // namespace vkpose::python

@@ -266,8 +266,8 @@ def draw(rgb: npt.NDArray[np.uint8], detections: Result | Sequence[Detection], *
 def plan_picks(result: Result, grasps: PathLike | Sequence[PathLike], depth: npt.NDArray[Any], *,
                bin: PathLike | None = None, order: str = "combined", max_tilt: float = 45.0,
                approach_axis: Sequence[float] | None = None,
-               min_outline_on_edges: float = 0.5, min_colour_agreement: float = 0.5,
-               colour_outline_allowance: float = 0.1) -> dict[str, Any]:
+               min_outline_on_edges: float = 0.5, min_colour_agreement: float = 0.68,
+               colour_outline_allowance: float = 0.25) -> dict[str, Any]:
     """Bin picking on a Result: valid and refused grasps per detection, and the pick list."""
 
 def load_frame(rgb: PathLike, depth: PathLike,

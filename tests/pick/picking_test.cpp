@@ -358,7 +358,7 @@ TEST(Picking, APoseWhoseColourDisagreesWithItsModelIsNotPicked) {
   ASSERT_EQ(plan.detections.size(), 3u);
   EXPECT_TRUE(plan.detections[0].valid.empty());
   ASSERT_EQ(plan.detections[0].refused.size(), 1u);
-  EXPECT_NE(plan.detections[0].refused[0].reason.find("colour agrees with the model's 0.30 (a pick needs 0.50)"),
+  EXPECT_NE(plan.detections[0].refused[0].reason.find("colour agrees with the model's 0.30 (a pick needs 0.68)"),
             std::string::npos)
       << plan.detections[0].refused[0].reason;
   EXPECT_FALSE(plan.detections[1].valid.empty());
@@ -377,18 +377,27 @@ TEST(Picking, AColourThatPassedLetsLessOfTheOutlineSitOnEdges) {
   coloured.outline_on_edges = 0.45f;
   Detection uncoloured = coloured, too_loose = coloured;
   coloured.colour_measured = too_loose.colour_measured = true;
-  coloured.colour_agreement = 0.85f;
-  too_loose.outline_on_edges = 0.35f;  // under the gate less the allowance
+  coloured.colour_agreement = too_loose.colour_agreement = 0.85f;
+  too_loose.outline_on_edges = 0.3f;  // under the gate less the allowance (0.156 at 0.85)
   const auto refusal = [&](const Detection& d, const PickParams& params) {
     const PickPlan plan = planPicks({d}, {bank}, {grasps}, cv::Mat(), camera(), std::nullopt, params);
     return plan.detections.at(0).valid.empty() ? plan.detections.at(0).refused.at(0).reason : std::string();
   };
-  EXPECT_EQ(refusal(coloured, {}), "") << "its colour was measured and passed: 40 % of the outline is enough";
+  EXPECT_EQ(refusal(coloured, {}), "") << "its colour was measured and passed: 34 % of the outline is enough";
   EXPECT_NE(refusal(uncoloured, {}).find("for 45.0 % of it (a pick needs 50 %)"), std::string::npos)
       << "no colour measured (a mesh without colours): the whole gate";
-  EXPECT_NE(refusal(too_loose, {}).find("for 35.0 % of it (a pick needs 40 %, its colour having passed)"),
+  EXPECT_NE(refusal(too_loose, {}).find("for 30.0 % of it (a pick needs 34 %, its colour having passed)"),
             std::string::npos)
       << refusal(too_loose, {});
+  // The allowance grows with the colour's agreement: all of it at 1, none at 0.6.
+  Detection full = too_loose, barely = coloured;
+  full.colour_agreement = 1.f;
+  EXPECT_EQ(refusal(full, {}), "") << "colours that agree fully: 25 % of the outline is enough";
+  PickParams low_gate;  // a gate under the allowance's start: a colour that passed it at 0.6 earns nothing
+  low_gate.min_colour_agreement = 0.5f;
+  barely.colour_agreement = 0.6f;
+  EXPECT_NE(refusal(barely, low_gate).find("(a pick needs 50 %, its colour having passed)"), std::string::npos)
+      << refusal(barely, low_gate);
   PickParams no_allowance;
   no_allowance.colour_outline_allowance = 0.f;
   EXPECT_NE(refusal(coloured, no_allowance), "");
