@@ -382,8 +382,9 @@ void addPickFlags(CLI::App* sub, CLI::Option* grasps, std::string& pick_order, P
       ->needs(grasps)
       ->group(group);
   sub->add_option("--colour-outline-allowance", pick.colour_outline_allowance,
-                  "--min-outline-fit asks up to this much less of a detection whose colour was measured and passed "
-                  "--min-colour-fit: all of it at a colour agreement of 1, none at 0.6, linear between")
+                  fmt::format("--min-outline-fit asks up to this much less of a detection whose colour was measured and "
+                              "passed --min-colour-fit: all of it at a colour agreement of 1, none at {:g}, linear between",
+                              kColourOutlineAllowanceFrom))
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str()
       ->needs(grasps)

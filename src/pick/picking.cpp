@@ -284,11 +284,10 @@ PlacedGrasp placeGrasp(const Grasp& g, const Pose& object_pose, const Eigen::Vec
 std::string poseTooUncertainToPick(const Detection& d, const PickParams& params) {
   const bool colour_gate = params.min_colour_agreement > 0.f;
   const bool colour_passed = colour_gate && d.colour_measured && d.colour_agreement >= params.min_colour_agreement;
-  const float allowance =
-      colour_passed ? params.colour_outline_allowance *
-                          std::clamp((d.colour_agreement - kColourOutlineAllowanceFrom) / (1.f - kColourOutlineAllowanceFrom), 0.f, 1.f)
-                    : 0.f;
-  const float min_outline = params.min_outline_on_edges - allowance;
+  // The allowance's share: none at kColourOutlineAllowanceFrom, all of it at an agreement of 1.
+  const float share =
+      std::clamp((d.colour_agreement - kColourOutlineAllowanceFrom) / (1.f - kColourOutlineAllowanceFrom), 0.f, 1.f);
+  const float min_outline = params.min_outline_on_edges - (colour_passed ? share * params.colour_outline_allowance : 0.f);
   if (params.min_outline_on_edges > 0.f && d.outline_on_edges < min_outline)  // false for NaN: not measured
     return fmt::format("the pose's outline lies on the image's edges for {:.1f} % of it (a pick needs {:.0f} %{}): too "
                        "uncertain a pose to grip, or something else of its size",
