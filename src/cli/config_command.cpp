@@ -24,7 +24,7 @@ void addSensorOption(CLI::App* sub, std::string& sensor, const std::string& what
   for (const auto& n : sensorProfileNames()) names += (names.empty() ? "" : "|") + n;
   sub->add_option("--sensor", sensor,
                   fmt::format("Depth sensor: {} (default {}), or a JSON file {{\"axial_sigma_at_1m\": m, "
-                              "\"quantization_m\": m}}; {}",
+                              "\"quantization_m\": m, \"small_parts_unreliable\": bool}}; {}",
                               names, sensorProfileNames().front(), what));
 }
 

@@ -436,7 +436,9 @@ Runner addDetectCommand(CLI::App& app, const GlobalOptions& global) {
   sub->add_flag("--overlays", opt->overlays, "Sequences: also write NAME.png overlays into --out-dir")->needs(out_dir);
   sub->add_flag("--force", opt->force, "Overwrite output files that exist");
   addConfigOption(sub, opt->config);
-  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  addSensorOption(sub, opt->sensor,
+                  "its noise sets the lengths that follow each object (vkpose config --explain); with close-range, "
+                  "parts under 10 cm are also matched on colour alone (their depth is unreliable)");
   addStageFlags(sub, p, "Stage parameters");
   auto* picking = "Bin picking (docs/picking.md)";
   auto* grasps = sub->add_option("--grasps", opt->grasps,

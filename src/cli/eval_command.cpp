@@ -400,7 +400,9 @@ Runner addEvalCommand(CLI::App& app, const GlobalOptions& global) {
   addParamFlag(sub, p.detector, "--threads", "; with --workers, the cores shared out among the workers");
   addSpreadOptions(sub, *opt);
   addConfigOption(sub, opt->config);
-  addSensorOption(sub, opt->sensor, "its noise sets the lengths that follow each object (vkpose config --explain)");
+  addSensorOption(sub, opt->sensor,
+                  "its noise sets the lengths that follow each object (vkpose config --explain); with close-range, "
+                  "parts under 10 cm are also matched on colour alone (their depth is unreliable)");
   addPickingOptions(sub, *opt);
   addProtocolOptions(sub, p);
   addMethodOptions(sub, p);

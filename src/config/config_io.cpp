@@ -26,6 +26,7 @@ std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
       {"match", "threshold", "LINEMOD similarity a match needs, percent", &p.match.threshold, aboveUpTo(0, 100), "--threshold"},
       {"match", "depth_pruning", "score templates only where the scene depth suits their distance", &p.match.depth_pruning},
       {"match", "outside_response", "response a template feature outside the image counts, 0..4", &p.match.outside_response, closed(0, 4)},
+      {"match", "small_part_colour_alone", "parts under 10 cm, with a sensor.small_parts_unreliable: also match each template on its colour features alone", &p.match.small_part_colour_alone},
       {"cluster", "position_step_px", "clustering cell s_im, pixels", &p.cluster.position_step_px, closed(1, 512), "--cluster-step"},
       {"cluster", "min_templates", "smallest cluster tau_c, templates", &p.cluster.min_templates, atLeast(1), "--min-templates"},
       {"score", "depth_unit_m", "alpha = exp(-depth error / unit), metres", &p.score.depth_unit_m, above(0), "--depth-unit"},
@@ -143,6 +144,7 @@ std::vector<ConfigField> verifyFields(DetectorParams& p) {
        "a pose with less than this share of min_silhouette_support is not compared with its alternatives, 0..1", &p.verify.hopeless_support_share, closed(0, 1)},
       {"sensor", "axial_sigma_at_1m", "depth noise sigma(z) = this * z^2, metres at 1 m", &p.sensor.axial_sigma_at_1m, fromBelow(0, 1)},
       {"sensor", "quantization_m", "the depth images' step, metres", &p.sensor.quantization_m, fromBelow(0, 1)},
+      {"sensor", "small_parts_unreliable", "parts under 10 cm show poorly in its depth (thin, shiny): small parts are also matched on colour alone", &p.sensor.small_parts_unreliable},
       {"detector", "scale_lengths", "lengths left at their defaults follow each object's size and the sensor's noise", &p.scale_lengths},
   };
 }

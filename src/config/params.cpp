@@ -47,11 +47,11 @@ struct NamedSensor {
 // writes millimetre depth images. synth adds the close-range camera's other effects
 // (closeRangeNoise, synth.hpp).
 constexpr NamedSensor kSensors[] = {
-    {"kinect", {0.0015f, 0.001f}},
-    {"primesense", {0.0010f, 0.001f}},
-    {"realsense-d435", {0.0025f, 0.001f}},
-    {"close-range", {0.0020f, 0.001f}},
-    {"ideal", {0.f, 0.f}},
+    {"kinect", {0.0015f, 0.001f, false}},
+    {"primesense", {0.0010f, 0.001f, false}},
+    {"realsense-d435", {0.0025f, 0.001f, false}},
+    {"close-range", {0.0020f, 0.001f, true}},
+    {"ideal", {0.f, 0.f, false}},
 };
 }  // namespace
 
@@ -79,11 +79,18 @@ SensorParams sensorProfile(const std::string& name_or_file) {
   SensorParams p;
   if (!j.is_object()) throw InputError(name_or_file + ": a sensor file is a JSON object");
   for (const auto& item : j.items()) {
+    if (item.key() == "small_parts_unreliable") {
+      if (!item.value().is_boolean())
+        throw InputError(fmt::format("{}: small_parts_unreliable must be true or false", name_or_file));
+      p.small_parts_unreliable = item.value().get<bool>();
+      continue;
+    }
     float* field = item.key() == "axial_sigma_at_1m" ? &p.axial_sigma_at_1m
                    : item.key() == "quantization_m"  ? &p.quantization_m
                                                      : nullptr;
     if (!field)
-      throw InputError(fmt::format("{}: unknown key \"{}\" (axial_sigma_at_1m, quantization_m)", name_or_file, item.key()));
+      throw InputError(fmt::format("{}: unknown key \"{}\" (axial_sigma_at_1m, quantization_m, small_parts_unreliable)",
+                                   name_or_file, item.key()));
     if (!item.value().is_number())
       throw InputError(fmt::format("{}: {} must be a number of metres", name_or_file, item.key()));
     *field = item.value().get<float>();

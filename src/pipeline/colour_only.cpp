@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <fmt/format.h>
 
+#include "match/match_templates.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pose/appearance.hpp"
 #include "render/render.hpp"
@@ -34,14 +36,8 @@ std::vector<LinemodTemplate> colourTemplates(const std::vector<TemplateBank>& ba
           "give the depth image, or train the bank with colour (the default)",
           bank.object));
     for (const BankTemplate& t : bank.templates) {
-      LinemodTemplate c = t.linemod;
-      bool usable = true;
-      for (TemplateLevel& level : c.levels) {
-        std::erase_if(level.features, [](const TemplateFeature& f) { return f.modality != Modality::ColourGradient; });
-        usable = usable && !level.features.empty();
-      }
-      if (usable) {
-        out.push_back(std::move(c));
+      if (std::optional<LinemodTemplate> c = match::colourFeaturesAlone(t.linemod)) {
+        out.push_back(std::move(*c));
         global_ids.push_back(id);
       }
       ++id;

@@ -10,6 +10,7 @@
 #include "gpu/batch.hpp"
 #include "hypotheses/cluster_score.hpp"
 #include "hypotheses/hypotheses.hpp"
+#include "match/match_templates.hpp"
 #include "match/matcher.hpp"
 #include "pipeline/colour_only.hpp"
 #include "pipeline/pipeline.hpp"
@@ -49,7 +50,11 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   }
   validateDetectorParams(params_);
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
-  matcher_->setTemplates(concatenateTemplates(banks_), match::templateDepthGates(banks_));
+  match::MatchTemplates templates = match::matchTemplates(banks_, params_.match, params_.sensor);
+  matcher_->setTemplates(std::move(templates.templates), std::move(templates.gates));
+  templates.templates.clear();
+  templates.gates.clear();
+  match_templates_ = std::make_unique<match::MatchTemplates>(std::move(templates));
   scorer_ = std::make_unique<ClusterScorer>(ctx_);
   objects_ = poseObjects(banks_, params_);
 }
@@ -150,6 +155,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   const auto total0 = std::chrono::steady_clock::now();
   // Started while the previous frame's CPU stages ran (detectSequence), or now.
   std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
+  match::asBankTemplateMatches(matches, *match_templates_);
   appendMatchTimings(matcher_->lastTimings(), result);
   result.matches = matches.size();
   result.match_pairs = matcher_->lastTimings().pairs;

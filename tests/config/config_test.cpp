@@ -129,6 +129,11 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
   EXPECT_GT(close.specular_dropout, 0.f);
   EXPECT_EQ(synthNoise("kinect").matching_window_px, 0);
   EXPECT_EQ(synthNoise("kinect").specular_dropout, 0.f);
+  // The close-range camera's depth of small parts is unreliable (the detector also matches
+  // them on colour alone); the others' is not.
+  EXPECT_TRUE(sensorProfile("close-range").small_parts_unreliable);
+  for (const std::string name : {"kinect", "primesense", "realsense-d435", "ideal"})
+    EXPECT_FALSE(sensorProfile(name).small_parts_unreliable) << name;
   // A noisier sensor makes a small part's lengths coarser at the same distance.
   DetectorParams p;
   p.sensor = d435;
@@ -142,6 +147,11 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
   std::ofstream(bad) << R"({"sigma": 0.002})";
   EXPECT_FLOAT_EQ(sensorProfile(file).axial_sigma_at_1m, 0.002f);
   EXPECT_FLOAT_EQ(sensorProfile(file).quantization_m, 0.0005f);
+  EXPECT_FALSE(sensorProfile(file).small_parts_unreliable);
+  const std::string stereo = (dir / "stereo.json").string(), not_bool = (dir / "not_bool.json").string();
+  std::ofstream(stereo) << R"({"axial_sigma_at_1m": 0.002, "small_parts_unreliable": true})";
+  std::ofstream(not_bool) << R"({"small_parts_unreliable": 1})";
+  EXPECT_TRUE(sensorProfile(stereo).small_parts_unreliable);
   auto message = [](const std::string& what) {
     try {
       sensorProfile(what);
@@ -152,6 +162,7 @@ TEST(SensorProfiles, NamesFilesAndWhatTheySet) {
   };
   EXPECT_NE(message("kinnect").find("kinect, primesense, realsense-d435, close-range, ideal"), std::string::npos);
   EXPECT_NE(message(bad).find("unknown key \"sigma\""), std::string::npos);
+  EXPECT_NE(message(not_bool).find("small_parts_unreliable must be true or false"), std::string::npos);
 }
 
 // The one parameter table: each number has one range, its default lies in it, and a value
