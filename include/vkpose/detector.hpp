@@ -21,7 +21,7 @@ namespace vkpose {
 // Stage internals the Detector holds (src/).
 class LinemodMatcher;
 namespace match {
-struct MatchTemplates;
+struct TemplateOrigins;
 }
 class ClusterScorer;
 class MeshRenderer;
@@ -57,9 +57,8 @@ class Detector {
   std::vector<TemplateBank> banks_;
   DetectorParams params_;
   std::unique_ptr<LinemodMatcher> matcher_;
-  /// Which bank template each of the matcher's templates matches for (its templates
-  /// themselves are the matcher's).
-  std::unique_ptr<match::MatchTemplates> match_templates_;
+  /// Which bank template each of the matcher's templates matches for.
+  std::unique_ptr<match::TemplateOrigins> template_origins_;
   std::unique_ptr<ClusterScorer> scorer_;
   std::vector<std::unique_ptr<MeshRenderer>> renderers_;  ///< one per bank, for stages 6-8 (made at first use)
   /// per bank: what stages 6-8 know of its object (src/pose/candidate.hpp): its renderer,

@@ -30,8 +30,7 @@ MatchTemplates matchTemplates(const std::vector<TemplateBank>& banks, const Matc
   out.gates = templateDepthGates(banks);
   for (const TemplateBank& bank : banks)
     for (const BankTemplate& t : bank.templates) out.templates.push_back(t.linemod);
-  out.bank_templates = out.templates.size();
-  for (std::size_t i = 0; i < out.bank_templates; ++i) out.bank_template.push_back(static_cast<int>(i));
+  out.origins.bank_templates = out.templates.size();
   if (!params.small_part_colour_alone || !sensor.small_parts_unreliable) return out;
   std::size_t first = 0;  // the bank's first template
   for (const TemplateBank& bank : banks) {
@@ -43,15 +42,15 @@ MatchTemplates matchTemplates(const std::vector<TemplateBank>& banks, const Matc
         if (!alone) continue;
         out.templates.push_back(std::move(*alone));
         out.gates.push_back(out.gates[i]);
-        out.bank_template.push_back(static_cast<int>(i));
+        out.origins.copy_of.push_back(static_cast<int>(i));
       }
     first += bank.templates.size();
   }
   return out;
 }
 
-void asBankTemplateMatches(std::vector<Match>& matches, const MatchTemplates& templates) {
-  if (templates.bank_template.size() == templates.bank_templates) return;  // nothing but bank templates
+void asBankTemplateMatches(std::vector<Match>& matches, const TemplateOrigins& origins) {
+  if (origins.copy_of.empty()) return;  // nothing but bank templates
   struct Tagged {
     Match match;
     bool copy;  // of a colour-alone copy
@@ -60,8 +59,9 @@ void asBankTemplateMatches(std::vector<Match>& matches, const MatchTemplates& te
   tagged.reserve(matches.size());
   for (Match m : matches) {
     const std::size_t id = static_cast<std::size_t>(m.template_id);
-    m.template_id = templates.bank_template[id];
-    tagged.push_back({m, id >= templates.bank_templates});
+    const bool copy = id >= origins.bank_templates;
+    if (copy) m.template_id = origins.copy_of[id - origins.bank_templates];
+    tagged.push_back({m, copy});
   }
   // Per bank template and position: its own match first, then the best similarity.
   std::sort(tagged.begin(), tagged.end(), [](const Tagged& a, const Tagged& b) {

@@ -20,13 +20,17 @@ namespace vkpose::match {
 /// A template's colour features alone, every level: none when a level would have none.
 std::optional<LinemodTemplate> colourFeaturesAlone(const LinemodTemplate& t);
 
+/// Which bank template each of the matcher's templates matches for: the first `bank_templates`
+/// are the bank templates themselves (in concatenateTemplates' order), then the copies.
+struct TemplateOrigins {
+  std::size_t bank_templates = 0;
+  std::vector<int> copy_of;  ///< per copy, the index of the bank template it was made from
+};
+
 struct MatchTemplates {
   std::vector<LinemodTemplate> templates;
   std::vector<TemplateDepthGate> gates;  ///< one per template (the bank template's)
-  /// The bank template (index in concatenateTemplates' order) each matches for: the first
-  /// `bank_templates` are the bank templates themselves.
-  std::vector<int> bank_template;
-  std::size_t bank_templates = 0;
+  TemplateOrigins origins;
 };
 
 /// The bank templates (and depth gates) and, with MatchParams::small_part_colour_alone and a
@@ -36,10 +40,10 @@ struct MatchTemplates {
 MatchTemplates matchTemplates(const std::vector<TemplateBank>& banks, const MatchParams& params,
                               const SensorParams& sensor);
 
-/// The matches of `templates` as the bank templates' (Match::template_id becomes the bank
+/// The matches of the matcher's templates as the bank templates' (Match::template_id becomes the bank
 /// template's index), best first as sortMatches leaves them. Where a bank template and its
 /// colour-alone copy matched at one position, the bank template's own match stands: its
 /// similarity counts both modalities, and colour alone only adds the positions it missed.
-void asBankTemplateMatches(std::vector<Match>& matches, const MatchTemplates& templates);
+void asBankTemplateMatches(std::vector<Match>& matches, const TemplateOrigins& origins);
 
 }  // namespace vkpose::match

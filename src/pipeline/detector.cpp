@@ -52,9 +52,7 @@ Detector::Detector(GpuContext& ctx, std::vector<TemplateBank> banks, DetectorPar
   matcher_ = std::make_unique<LinemodMatcher>(ctx_, banks_.front().params.features, params_.match);
   match::MatchTemplates templates = match::matchTemplates(banks_, params_.match, params_.sensor);
   matcher_->setTemplates(std::move(templates.templates), std::move(templates.gates));
-  templates.templates.clear();
-  templates.gates.clear();
-  match_templates_ = std::make_unique<match::MatchTemplates>(std::move(templates));
+  template_origins_ = std::make_unique<match::TemplateOrigins>(std::move(templates.origins));
   scorer_ = std::make_unique<ClusterScorer>(ctx_);
   objects_ = poseObjects(banks_, params_);
 }
@@ -155,7 +153,7 @@ DetectionResult Detector::detectFrame(const LinemodFrame& frame, const Camera& f
   const auto total0 = std::chrono::steady_clock::now();
   // Started while the previous frame's CPU stages ran (detectSequence), or now.
   std::vector<Match> matches = submitted ? matcher_->collect() : matcher_->match(frame);
-  match::asBankTemplateMatches(matches, *match_templates_);
+  match::asBankTemplateMatches(matches, *template_origins_);
   appendMatchTimings(matcher_->lastTimings(), result);
   result.matches = matches.size();
   result.match_pairs = matcher_->lastTimings().pairs;

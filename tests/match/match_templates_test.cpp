@@ -42,15 +42,15 @@ TEST(MatchTemplates, SmallPartsAreAlsoMatchedOnColourAloneWhereTheSensorLosesThe
   const std::vector<TemplateBank> banks = {bank("key", 0.17f), bank("nozzle", 0.06f)};
   ASSERT_TRUE(closeRange().small_parts_unreliable);
   const match::MatchTemplates t = match::matchTemplates(banks, MatchParams{}, closeRange());
-  ASSERT_EQ(t.bank_templates, 6u);
+  ASSERT_EQ(t.origins.bank_templates, 6u);
   // The nozzle's first and last templates have depth features: each gets a copy; its second
   // is colour alone already. The 17 cm key gets none.
   ASSERT_EQ(t.templates.size(), 8u);
   ASSERT_EQ(t.gates.size(), 8u);
-  ASSERT_EQ(t.bank_template, (std::vector<int>{0, 1, 2, 3, 4, 5, 3, 5}));
+  ASSERT_EQ(t.origins.copy_of, (std::vector<int>{3, 5}));
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(t.templates[i], banks[i / 3].templates[i % 3].linemod) << i;
   for (const std::size_t copy : {6u, 7u}) {
-    const LinemodTemplate& own = t.templates[static_cast<std::size_t>(t.bank_template[copy])];
+    const LinemodTemplate& own = t.templates[static_cast<std::size_t>(t.origins.copy_of[copy - 6])];
     const LinemodTemplate& alone = t.templates[copy];
     ASSERT_EQ(alone.levels.size(), own.levels.size());
     for (std::size_t l = 0; l < own.levels.size(); ++l) {
@@ -63,7 +63,7 @@ TEST(MatchTemplates, SmallPartsAreAlsoMatchedOnColourAloneWhereTheSensorLosesThe
     }
     // The depth gate is the bank template's: the same distance and anchor.
     const auto& g = t.gates[copy];
-    const auto& own_gate = t.gates[static_cast<std::size_t>(t.bank_template[copy])];
+    const auto& own_gate = t.gates[static_cast<std::size_t>(t.origins.copy_of[copy - 6])];
     EXPECT_EQ(g.z_lo_mm, own_gate.z_lo_mm);
     EXPECT_EQ(g.z_hi_mm, own_gate.z_hi_mm);
     EXPECT_EQ(g.anchor_dc, own_gate.anchor_dc);
@@ -92,13 +92,13 @@ TEST(MatchTemplates, ACopysMatchesCountAsItsBankTemplatesWhereItsOwnDidNotMatch)
       m(7, -4, 5, 90.f),   // a repeat at the same place: the better one
       m(0, 50, 50, 81.f),  // the key's
   };
-  match::asBankTemplateMatches(matches, t);
+  match::asBankTemplateMatches(matches, t.origins);
   const std::vector<Match> expected = {m(3, 30, 10, 92.f), m(5, -4, 5, 90.f), m(3, 10, 10, 84.f), m(0, 50, 50, 81.f)};
   EXPECT_EQ(matches, expected);
   // Without copies the matches are left as they are.
   const match::MatchTemplates plain = match::matchTemplates(banks, MatchParams{}, SensorParams{});
   std::vector<Match> same = {m(3, 10, 10, 84.f), m(0, 1, 1, 99.f)};
-  match::asBankTemplateMatches(same, plain);
+  match::asBankTemplateMatches(same, plain.origins);
   EXPECT_EQ(same, (std::vector<Match>{m(3, 10, 10, 84.f), m(0, 1, 1, 99.f)}));
 }
 
