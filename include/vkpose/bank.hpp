@@ -65,6 +65,12 @@ struct ViewSamplingParams {
   SteppedRange radii{0.6f, 1.0f, 0.1f};
   /// In-plane rotations about the optical axis, degrees. Paper: -60 to +60, 10 apart.
   SteppedRange inplane_deg{-60.f, 60.f, 10.f};
+  /// Viewpoints within this angle (degrees) of their hemisphere's pole take in-plane rotations
+  /// over the whole turn instead (fullTurnInPlane, at fullTurnStep about its middle). Seen
+  /// from near its up axis, a part's turn in the image is its turn about that axis (in a bin,
+  /// chance) and where in the image it lies under a camera looking down, not the camera's
+  /// roll that inplane_deg bounds. 0: inplane_deg for every viewpoint (the paper's sampling).
+  float full_turn_within_deg = 0.f;
   /// The object's up direction (object frame, unit): the (hemi)sphere is sampled about it and
   /// image "up" follows it, so templates show the object as it stands. `vkpose train` finds it
   /// (findUpAxis) unless --up names one; +z is the modelling convention.
@@ -76,8 +82,17 @@ struct ViewSamplingParams {
   std::vector<Eigen::Vector3f> other_ups;
 };
 
-/// Throws InputError when the counts or ranges are out of bounds, `up` or one of `other_ups` is
-/// not a unit vector, there are more than five other ups, or other ups come with the full sphere.
+/// The whole turn's step where --inplane is one angle (whose step says nothing), degrees.
+inline constexpr float kFullTurnSingleAngleStepDeg = 10.f;
+/// `inplane`'s step, or kFullTurnSingleAngleStepDeg where it holds one angle.
+float fullTurnStep(const SteppedRange& inplane);
+/// The in-plane rotations of a whole turn at fullTurnStep, centred on `inplane`'s middle
+/// (-60:60:10 gives -180 to 170): what views near a hemisphere's pole take
+/// (full_turn_within_deg).
+std::vector<float> fullTurnInPlane(const SteppedRange& inplane);
+
+/// Throws InputError when the counts or ranges are out of bounds (full_turn_within_deg outside
+/// 0 to 90), `up` or one of `other_ups` is not a unit vector, there are more than five other ups, or other ups come with the full sphere.
 void validateViewSampling(const ViewSamplingParams& params);
 
 // ---- the up axis -----------------------------------------------------------------------
@@ -185,6 +200,13 @@ std::vector<Eigen::Vector3f> otherRestingUps(const UpAxisChoice& choice, const E
 /// its side), so `--resting auto` trains every resting pose.
 inline constexpr float kPileDistanceM = 0.5f;
 
+/// What planTraining gives ViewSamplingParams::full_turn_within_deg by default for a part it
+/// trains to lie in a bin (trainsOtherRestingPoses): a camera looking down sees parts within
+/// its half field of view (29-36 degrees for a 640 x 480 image at f 572) plus a pile's tilt
+/// of the up axis at any turn (on the metal piles every key that needed an in-plane turn past
+/// 60 degrees was seen within 36 degrees of a pole; docs/history.md).
+inline constexpr float kPileFullTurnWithinDeg = 40.f;
+
 /// Whether training covers the other resting poses: `resting` is "all", "up" or "auto" (all for
 /// a part smaller than kSmallPartDiameterM, config.hpp, or trained nearer than kPileDistanceM:
 /// parts picked from bins lie any way up, while larger objects seen from farther mostly stand).
@@ -223,6 +245,15 @@ std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Ei
 /// camera looking down, the rest of the hemisphere is templates that can only match wrongly.
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,
                                      float max_polar_deg);
+
+/// `views` less the views that turn past `inplane` (those the whole turn near a pole added,
+/// ViewSamplingParams::full_turn_within_deg) and show what a view within it already shows: the
+/// same rotation, or the same after one of `symmetries`, within `tolerance_deg`. With several
+/// resting poses most of the whole turn is seen from another pole's views already (the 40 mm
+/// bracket keeps 6 % more templates); a spark-plug key lying flat gains the turns no view of it
+/// had (18 % more). The order is kept.
+std::vector<TrainingView> dropTurnsShownAlready(const std::vector<TrainingView>& views, const SteppedRange& inplane,
+                                                const std::vector<NearSymmetry>& symmetries, float tolerance_deg);
 
 // ---- LINEMOD templates -----------------------------------------------------------------
 
@@ -330,11 +361,13 @@ struct TrainingPlan {
 };
 
 /// Fills in `params.views`: `up` from findUpAxis where `auto_up` (else it is kept as given), and
-/// `other_ups` where trainsOtherRestingPoses(`resting`) and not the full sphere; then samples
-/// the views within `max_view_angle_deg` of each hemisphere's top. Throws InputError for a
-/// `resting` other than auto, all, up, or when no view is left.
+/// `other_ups` where trainsOtherRestingPoses(`resting`) and not the full sphere, and
+/// `full_turn_within_deg` (`full_turn_within_deg` where given, else kPileFullTurnWithinDeg for
+/// a part trained to lie in a bin and 0 otherwise); then samples the views within
+/// `max_view_angle_deg` of each hemisphere's top. Throws InputError for a `resting` other than
+/// auto, all, up, or when no view is left.
 TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up, const std::string& resting,
-                          float max_view_angle_deg);
+                          float max_view_angle_deg, std::optional<float> full_turn_within_deg = std::nullopt);
 
 /// Depth and normals of a rendered template, sampled every `stride` pixels over the object's
 /// box: cell (i, j) is template pixel (x0 + j * stride, y0 + i * stride) (level 0, relative
@@ -404,8 +437,9 @@ TemplateBank trainTemplatesFromViews(const GpuContext& ctx, const Mesh& mesh, co
 
 /// Bank files (.vkpb): a versioned header, the training parameters, all templates, and an
 /// FNV-1a 64 checksum of everything before it.
-// 2: the mesh is stored; 3: the up axis (2 reads as +z); 4: near-symmetries; 5: other resting ups
-constexpr uint32_t kBankVersion = 5;
+// 2: the mesh is stored; 3: the up axis (2 reads as +z); 4: near-symmetries; 5: other resting ups;
+// 6: the whole turn in-plane near the poles (older read as 0)
+constexpr uint32_t kBankVersion = 6;
 void saveBank(const TemplateBank& bank, const std::string& path);
 /// Throws InputError naming the file and the problem: missing, not a bank, another version,
 /// truncated, or a checksum mismatch.

@@ -187,6 +187,9 @@ void bindCore(py::module_& m) {
                              "(from, to, step), metres")
       .def_property_readonly("inplane", [](const TemplateBank& b) { return rangeTuple(b.params.views.inplane_deg); },
                              "(from, to, step), degrees")
+      .def_property_readonly(
+          "full_turn_within", [](const TemplateBank& b) { return b.params.views.full_turn_within_deg; },
+          "Viewpoints this near a pole (degrees) took in-plane rotations over the whole turn; 0: none")
       .def_property_readonly("centre", [](const TemplateBank& b) { return toArray(b.centre); },
                              "The point the training cameras looked at, object frame, metres")
       .def_property_readonly("mesh_vertices", [](const TemplateBank& b) { return verticesOf(b.mesh.vertices); },
@@ -212,7 +215,7 @@ void bindCore(py::module_& m) {
       [](const py::object& mesh_path, const std::string& units, int views, const py::object& radii,
          const py::object& inplane, const std::string& hemisphere, float max_view_angle, int features,
          const py::object& camera, bool symmetric, const std::string& up, const std::string& resting,
-         bool allow_small, const py::object& device,
+         bool allow_small, const py::object& full_turn_within, const py::object& device,
          const py::object& cache_dir, const py::object& progress) {
         TrainingParams params;
         params.views.viewpoints = views;
@@ -229,6 +232,12 @@ void bindCore(py::module_& m) {
           valueError(fmt::format("resting: '{}' is none of 'auto', 'all', 'up'", resting));
         if (!(max_view_angle >= 1.f && max_view_angle <= 180.f))
           valueError(fmt::format("max_view_angle: {} is not within 1..180 degrees", max_view_angle));
+        std::optional<float> full_turn;
+        if (!full_turn_within.is_none()) {
+          full_turn = full_turn_within.cast<float>();
+          if (!(*full_turn >= 0.f && *full_turn <= 90.f))
+            valueError(fmt::format("full_turn_within: {} is not within 0..90 degrees", *full_turn));
+        }
         validateTrainingParams(params);
         const std::string path = pathOf(mesh_path, "mesh");
         const std::string cache = cache_dir.is_none() ? std::string() : pathOf(cache_dir, "cache_dir");
@@ -245,7 +254,7 @@ void bindCore(py::module_& m) {
         const auto report = progressOf(progress, "training");
         py::gil_scoped_release nogil;
         const std::vector<TrainingView> training_views =
-            planTraining(mesh, params, up == "auto", resting, max_view_angle).views;
+            planTraining(mesh, params, up == "auto", resting, max_view_angle, full_turn).views;
         std::lock_guard<std::mutex> lock(dev->mutex);
         if (!cache.empty())
           return std::make_shared<TemplateBank>(
@@ -257,7 +266,7 @@ void bindCore(py::module_& m) {
       py::arg("radii") = "0.6:1.0:0.1", py::arg("inplane") = "-60:60:10", py::arg("hemisphere") = "upper",
       py::arg("max_view_angle") = 180.f, py::arg("features") = 63, py::arg("camera") = py::none(),
       py::arg("symmetric") = false, py::arg("up") = "auto", py::arg("resting") = "auto",
-      py::arg("allow_small") = false, py::arg("device") = py::none(),
+      py::arg("allow_small") = false, py::arg("full_turn_within") = py::none(), py::arg("device") = py::none(),
       py::arg("cache_dir") = py::none(),
       py::arg("progress") = py::none(),
       R"(Renders a mesh from every training view on the GPU and returns its template bank,
@@ -274,7 +283,9 @@ the up axis only), 'all' (also a hemisphere about each other pose it rests in, l
 down, that no near-symmetry covers: up to 6x the templates) or 'auto' (all for a part smaller
 than 10 cm across or trained nearer than 0.5 m, up otherwise). allow_small: train a part under
 2 cells of LINEMOD's coarsest level across (or 1 wide) at the nearest radius, which raises ValueError
-otherwise (too small to tell from its neighbourhood). device: None, an index or a Device. cache_dir: a folder
+otherwise (too small to tell from its neighbourhood). full_turn_within: viewpoints within this many
+degrees of a pole take in-plane rotations over the whole turn (None: 40 where resting trains the
+lying poses, a part in a bin, else 0). device: None, an index or a Device. cache_dir: a folder
 where banks are kept between runs (None: no cache). progress: True for a bar on stderr, or a
 callable(done, total).)");
 }

@@ -158,6 +158,8 @@ def test_training_checks_its_arguments_before_any_work(tmp_path):
         vkpose.train(mesh, progress=5)
     with pytest.raises(ValueError, match="resting"):
         vkpose.train(mesh, resting="sideways")
+    with pytest.raises(ValueError, match="full_turn_within"):
+        vkpose.train(mesh, full_turn_within=95)
 
 
 def test_training_refuses_an_object_too_small_for_linemod_unless_allowed():
@@ -180,5 +182,8 @@ def test_training_finds_the_up_axis(meshes):
     assert milk.up_axis == "-z" and milk.hemisphere == "upper"
     assert "up axis -z" in repr(milk)
     assert vkpose.train(meshes / "milk.stl", units="m", up="+z", **small).up_axis == "+z"
+    # Standing, seen from 0.6 m: no whole turn near the pole unless asked for.
+    assert milk.full_turn_within == 0.0
+    assert vkpose.train(meshes / "milk.stl", units="m", full_turn_within=25, **small).full_turn_within == 25.0
     with pytest.raises(ValueError, match="up axis 'z'"):
         vkpose.train(meshes / "milk.stl", units="m", up="z", **small)

@@ -102,6 +102,8 @@ class Bank:
     @property
     def inplane(self) -> tuple[float, float, float]: ...
     @property
+    def full_turn_within(self) -> float: ...
+    @property
     def centre(self) -> npt.NDArray[np.float64]: ...
     @property
     def mesh_vertices(self) -> npt.NDArray[np.float32]: ...
@@ -114,7 +116,7 @@ def train(mesh: PathLike, *, units: str = "auto", views: int = 216,
           inplane: str | float | tuple[float, float, float] = "-60:60:10", hemisphere: str = "upper",
           max_view_angle: float = 180.0, features: int = 63, camera: CameraArg | None = None,
           symmetric: bool = False, up: str = "auto", resting: str = "auto", allow_small: bool = False,
-          device: DeviceArg = None, cache_dir: PathLike | None = None,
+          full_turn_within: float | None = None, device: DeviceArg = None, cache_dir: PathLike | None = None,
           progress: Progress = None) -> Bank:
     """Renders a mesh from every training view and returns its template bank."""
 

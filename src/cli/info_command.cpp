@@ -47,6 +47,9 @@ void printBankSummary(const TemplateBank& bank, const std::string& path) {
              : p.views.other_ups.empty() ? "hemisphere above the up axis"
                                          : "a hemisphere above the up axis and one above each other resting pose's", p.views.radii.from, p.views.radii.to,
              p.views.radii.step, p.views.inplane_deg.from, p.views.inplane_deg.to, p.views.inplane_deg.step);
+  if (p.views.full_turn_within_deg > 0.f)
+    fmt::print("  the whole turn in-plane within {:.0f} deg of {}\n", p.views.full_turn_within_deg,
+               p.views.other_ups.empty() ? "the top" : "each up axis");
   fmt::print("features: {} per modality and level, T = {}, modalities {}{}, {:.1f} per template\n",
              p.features_per_modality, fmt::join(p.features.T, ","), p.features.use_colour ? "colour " : "",
              p.features.use_depth ? "depth" : "",

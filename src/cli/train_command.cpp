@@ -1,7 +1,9 @@
 // `vkpose train MESH --out BANK`: render the mesh from every training view and store the
 // LINEMOD templates in a bank file.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include <fmt/core.h>
@@ -19,7 +21,7 @@ using util::ProgressBar;
 namespace {
 struct TrainOptions {
   std::string mesh, out, units = "auto", radii = "0.6:1.0:0.1", inplane = "-60:60:10", hemisphere = "upper", camera,
-      up = "auto", resting = "auto";
+      up = "auto", resting = "auto", full_turn_within = "auto";
   int views = 216, features = 63;
   float max_view_angle = 180.f, near_symmetry_tolerance = TrainingParams{}.near_symmetry_tolerance;
   bool symmetric = false, force = false, allow_small = false;
@@ -69,6 +71,23 @@ void printPlan(const TrainingPlan& plan, const TrainingParams& params, const Mes
                : trained ? "a hemisphere of views about each as well"
                      : "not trained: pass --resting all to find it lying down too");
   }
+  if (params.views.full_turn_within_deg > 0.f)
+    fmt::print("in-plane: {}:{}:{} deg, the whole turn within {:.0f} deg of {} ({})\n", params.views.inplane_deg.from,
+               params.views.inplane_deg.to, params.views.inplane_deg.step, params.views.full_turn_within_deg,
+               params.views.other_ups.empty() ? "the top" : "each up axis",
+               opt.full_turn_within == "auto" ? "auto: seen from above, a part in a bin lies at any turn; "
+                                                "--full-turn-within 0 keeps the range everywhere"
+                                              : "--full-turn-within");
+}
+
+/// --full-turn-within: "auto" (planTraining decides) or degrees.
+std::optional<float> fullTurnWithin(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  float deg = 0.f;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%f%c", &deg, &tail) != 1 || !(deg >= 0.f && deg <= 90.f))
+    throw InputError(fmt::format("--full-turn-within '{}': auto, or degrees from 0 to 90", text));
+  return deg;
 }
 
 /// Templates without a depth feature although the bank was trained with depth.
@@ -85,6 +104,7 @@ std::size_t colourOnlyTemplates(const TemplateBank& bank) {
 /// `vkpose train`.
 ExitCode runTrain(const TrainOptions& opt, const GlobalOptions& global) {
   TrainingParams params = trainingParamsFrom(opt);
+  const std::optional<float> full_turn_within = fullTurnWithin(opt.full_turn_within);
   if (std::filesystem::exists(opt.out) && !opt.force)
     throw InputError(fmt::format("{} exists: pass --force to overwrite it", opt.out));
   MeshLoadReport report;
@@ -101,7 +121,8 @@ ExitCode runTrain(const TrainOptions& opt, const GlobalOptions& global) {
   if (size.too_small() && !opt.allow_small) throw InputError(size.refusal());
   if (!global.quiet) fmt::print("size: {}\n", size.summary());
   for (const std::string& w : trainingWarnings(mesh, params)) fmt::print(stderr, "vkpose: warning: {}\n", w);
-  const TrainingPlan plan = planTraining(mesh, params, opt.up == "auto", opt.resting, opt.max_view_angle);
+  const TrainingPlan plan =
+      planTraining(mesh, params, opt.up == "auto", opt.resting, opt.max_view_angle, full_turn_within);
   printPlan(plan, params, mesh, opt, global.verbose);
   GpuContext ctx(global.gpu());
   ProgressBar bar("training", global.quiet);
@@ -141,6 +162,11 @@ Runner addTrainCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   sub->add_option("--radii", opt->radii, "Camera distances FROM:TO:STEP, metres")->capture_default_str();
   sub->add_option("--inplane", opt->inplane, "In-plane rotations FROM:TO:STEP, degrees")->capture_default_str();
+  sub->add_option("--full-turn-within", opt->full_turn_within,
+                  "Viewpoints within this angle of an up axis (degrees, 0 to 90) take in-plane rotations over the "
+                  "whole turn at --inplane's step: seen from near its top, a part's turn in the image is chance, not "
+                  "the camera's roll; auto: 40 where the lying poses are trained (--resting), else 0")
+      ->capture_default_str();
   sub->add_option("--hemisphere", opt->hemisphere, "Viewpoints on the upper hemisphere or the full sphere")
       ->check(CLI::IsMember({"upper", "full"}))
       ->capture_default_str();

@@ -163,6 +163,7 @@ void writeParams(Writer& w, const TrainingParams& p) {
   w.put(static_cast<uint32_t>(p.views.other_ups.size()));  // version 5
   for (const Eigen::Vector3f& up : p.views.other_ups)
     for (int i = 0; i < 3; ++i) w.put(up[i]);
+  w.put(p.views.full_turn_within_deg);  // version 6
 }
 
 void writePayload(Writer& w, const TemplateBank& bank) {
@@ -300,6 +301,7 @@ TemplateBank readPayload(Reader& r, const std::string& path, uint32_t version) {
     for (Eigen::Vector3f& up : p.views.other_ups)
       for (int i = 0; i < 3; ++i) up[i] = r.get<float>();
   }
+  if (version >= 6) p.views.full_turn_within_deg = r.get<float>();  // older banks: the range everywhere
   try {
     validateTrainingParams(p);
   } catch (const InputError& e) {

@@ -191,19 +191,25 @@ bool trainsOtherRestingPoses(const std::string& resting, float diameter_m, float
 }
 
 TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up, const std::string& resting,
-                          float max_view_angle_deg) {
+                          float max_view_angle_deg, std::optional<float> full_turn_within_deg) {
   TrainingPlan plan;
   const bool trains_others =  // throws first on a bad name
       trainsOtherRestingPoses(resting, mesh.diameter, std::min(params.views.radii.from, params.views.radii.to));
   plan.found = findUpAxis(mesh);
   if (auto_up) params.views.up = plan.found.up;
   params.views.other_ups.clear();
+  const std::vector<NearSymmetry> symmetries =
+      findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter);
   if (!params.views.full_sphere) {
-    plan.other_ups = otherRestingUps(plan.found, params.views.up,
-                                     findNearSymmetries(mesh, params.near_symmetry_tolerance * mesh.diameter));
+    plan.other_ups = otherRestingUps(plan.found, params.views.up, symmetries);
     if (trains_others) params.views.other_ups = plan.other_ups;
   }
-  plan.views = viewsAbove(sampleViews(params.views, mesh.bboxCentre()), mesh.bboxCentre(), max_view_angle_deg);
+  params.views.full_turn_within_deg = full_turn_within_deg.value_or(trains_others ? kPileFullTurnWithinDeg : 0.f);
+  // The whole turn's views that a view of the range, or a near-symmetry of one, shows within a
+  // step already: a body of revolution seen down its axis gains nothing from them.
+  plan.views = viewsAbove(dropTurnsShownAlready(sampleViews(params.views, mesh.bboxCentre()), params.views.inplane_deg,
+                                                symmetries, fullTurnStep(params.views.inplane_deg)),
+                          mesh.bboxCentre(), max_view_angle_deg);
   if (plan.views.empty())
     throw InputError(fmt::format("no viewpoint lies within {} degrees of the top", max_view_angle_deg));
   return plan;

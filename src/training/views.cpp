@@ -1,6 +1,10 @@
 #include "vkpose/bank.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
+#include <utility>
 #include <numbers>
 
 #include <Eigen/Geometry>
@@ -43,6 +47,12 @@ void validateViewSampling(const ViewSamplingParams& p) {
     throw InputError(fmt::format("views: {} viewpoints; use 1 to 100000", p.viewpoints));
   checkRange(p.radii, "radii");
   checkRange(p.inplane_deg, "in-plane rotations");
+  if (!(p.full_turn_within_deg >= 0.f && p.full_turn_within_deg <= 90.f))
+    throw InputError(fmt::format("the whole turn in-plane within {} degrees of the top: use 0 to 90",
+                                 p.full_turn_within_deg));
+  if (p.full_turn_within_deg > 0.f && fullTurnStep(p.inplane_deg) < 0.1f)
+    throw InputError(fmt::format("in-plane step {} degrees: the whole turn needs a step of 0.1 degrees or more",
+                                 p.inplane_deg.step));
   for (float r : p.radii.values())
     if (!(r >= 0.05f && r <= 6.f)) throw InputError(fmt::format("radii: {} m is outside 0.05 to 6 m", r));
   // Up to a full turn either way, so that a range can be centred on 180 degrees (120:240:10)
@@ -109,26 +119,82 @@ TrainingView lookAtView(const Eigen::Vector3f& direction, const Eigen::Vector3f&
   return v;
 }
 
+float fullTurnStep(const SteppedRange& inplane) {
+  return inplane.values().size() > 1 ? inplane.step : kFullTurnSingleAngleStepDeg;
+}
+
+std::vector<float> fullTurnInPlane(const SteppedRange& inplane) {
+  checkRange(inplane, "in-plane rotations");
+  const float start = 0.5f * (inplane.from + inplane.to) - 180.f;
+  const float step = fullTurnStep(inplane);
+  std::vector<float> out;
+  for (int i = 0; static_cast<float>(i) * step < 360.f - 1e-3f; ++i) out.push_back(start + static_cast<float>(i) * step);
+  return out;
+}
+
 std::vector<TrainingView> sampleViews(const ViewSamplingParams& params, const Eigen::Vector3f& centre) {
   validateViewSampling(params);
   const auto dirs = sphereViewpoints(params.viewpoints, params.full_sphere);
   const auto radii = params.radii.values();
-  const auto angles = params.inplane_deg.values();
+  const auto range = params.inplane_deg.values();
+  const auto whole_turn = fullTurnInPlane(params.inplane_deg);
+  // The lattice's pole is +z: a viewpoint's z is the cosine of its angle from the top.
+  const float full_turn_min_z =
+      params.full_turn_within_deg > 0.f ? std::cos(params.full_turn_within_deg * std::numbers::pi_v<float> / 180.f)
+                                        : 2.f;
   std::vector<Eigen::Vector3f> ups{params.up};
   ups.insert(ups.end(), params.other_ups.begin(), params.other_ups.end());
   std::vector<TrainingView> views;
-  views.reserve(ups.size() * dirs.size() * radii.size() * angles.size());
+  views.reserve(ups.size() * dirs.size() * radii.size() * std::max(range.size(), whole_turn.size()));
   for (std::size_t k = 0; k < ups.size(); ++k) {
     const Eigen::Matrix3f turn = poleTo(ups[k]);
-    for (std::size_t i = 0; i < dirs.size(); ++i)
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const auto& angles = dirs[i].z() >= full_turn_min_z ? whole_turn : range;
       for (float r : radii)
         for (float a : angles) {
           auto v = lookAtView(turn * dirs[i], centre, r, a, ups[k]);
           v.viewpoint = static_cast<int>(k * dirs.size() + i);
           views.push_back(v);
         }
+    }
   }
   return views;
+}
+
+std::vector<TrainingView> dropTurnsShownAlready(const std::vector<TrainingView>& views, const SteppedRange& inplane,
+                                                const std::vector<NearSymmetry>& symmetries, float tolerance_deg) {
+  const auto within = [&](float a) { return a >= inplane.from - 1e-3f && a <= inplane.to + 1e-3f; };
+  // A view's picture hangs on its rotation alone (its radii share it): one per viewpoint and turn.
+  const auto key = [](const TrainingView& v) { return std::pair(v.viewpoint, std::lround(v.inplane_deg * 1000.f)); };
+  std::map<std::pair<int, long>, Eigen::Matrix3f> range, added;
+  for (const TrainingView& v : views) (within(v.inplane_deg) ? range : added).emplace(key(v), v.R);
+  std::vector<Eigen::Quaternionf> shown;
+  shown.reserve(range.size());
+  for (const auto& [k, R] : range) shown.emplace_back(R);
+  // A pose R and R * S show the same picture when S is a near-symmetry (and so is its inverse).
+  std::vector<Eigen::Matrix3f> turns{Eigen::Matrix3f::Identity()};
+  for (const NearSymmetry& s : symmetries) {
+    const Eigen::Matrix3f S = s.transform().R;
+    turns.push_back(S);
+    turns.push_back(S.transpose());
+  }
+  const float min_dot = std::cos(0.5f * tolerance_deg * std::numbers::pi_v<float> / 180.f);
+  std::set<std::pair<int, long>> repeated;
+  for (const auto& [k, R] : added)
+    for (const Eigen::Matrix3f& S : turns) {
+      const Eigen::Quaternionf q(Eigen::Matrix3f(R * S));
+      if (std::any_of(shown.begin(), shown.end(), [&](const Eigen::Quaternionf& b) {
+            return std::abs(b.dot(q)) >= min_dot;
+          })) {
+        repeated.insert(k);
+        break;
+      }
+    }
+  std::vector<TrainingView> out;
+  out.reserve(views.size());
+  for (const TrainingView& v : views)
+    if (!repeated.contains(key(v))) out.push_back(v);
+  return out;
 }
 
 std::vector<TrainingView> viewsAbove(const std::vector<TrainingView>& views, const Eigen::Vector3f& centre,

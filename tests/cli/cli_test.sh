@@ -53,6 +53,17 @@ if ! "$vkpose" -q train "$dir/cube.obj" --units m --views 2 --radii 0.6 --inplan
   cat "$dir/train.log"
   exit 1
 fi
+# The whole turn near the poles: a nonsense angle is refused before any work, no bank written.
+"$vkpose" -q train "$dir/cube.obj" --units m --views 2 --radii 0.6 --inplane 0 --full-turn-within 95 \
+  --out "$dir/turn.vkpb" >"$dir/turn.log" 2>&1
+rc=$?
+if [ $rc -ne 1 ] || [ -e "$dir/turn.vkpb" ] || ! grep -q "full-turn-within '95'" "$dir/turn.log"; then
+  echo "FAIL train: --full-turn-within 95 is refused (exit $rc):"
+  cat "$dir/turn.log"
+  failed=1
+else
+  echo "ok   train: $(head -c 160 "$dir/turn.log")"
+fi
 # A part too small for LINEMOD's coarse level at its distance (16 pixels, 1 cell): refused with
 # exit 1 and what to do, no bank written; with --allow-small a warning says so before the
 # training (which may then find too few features in every view: either exit is fine there).

@@ -1,6 +1,9 @@
 // Mesh loading, exact diameters and view sampling.
+#include <algorithm>
 #include <fstream>
+#include <map>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -193,6 +196,120 @@ TEST(ViewSampling, ImageUpIsTheObjectsUpAndInplaneRotatesAboutTheAxis) {
   EXPECT_NEAR(std::atan2(up_turned.x(), -up_turned.y()), 30.f * 3.14159265f / 180.f, 1e-4f);
   const TrainingView pole = lookAtView({0.f, 0.f, 1.f}, Eigen::Vector3f::Zero(), 0.8f, 0.f);
   EXPECT_TRUE(pole.R.allFinite());
+}
+
+// Near a hemisphere's pole the image's up hangs on where the camera stands, not on its roll:
+// a part lying flat under a camera looking down shows at any turn. The whole turn near the
+// pole (full_turn_within_deg) gives every such view a template close by; the paper's -60 to 60
+// leaves turns that no template comes near.
+TEST(ViewSampling, TheWholeTurnNearThePoleCoversAPartSeenFromAboveAtAnyTurn) {
+  const auto whole = fullTurnInPlane({-60.f, 60.f, 10.f});
+  ASSERT_EQ(whole.size(), 36u);
+  EXPECT_FLOAT_EQ(whole.front(), -180.f);
+  EXPECT_FLOAT_EQ(whole.back(), 170.f);
+  EXPECT_EQ(fullTurnInPlane({0.f, 10.f, 7.f}).size(), 52u);  // 0 to 357: no step past the turn
+  EXPECT_EQ(fullTurnInPlane({0.f, 0.f, 1.f}).size(), 36u);   // one angle: every 10 degrees
+
+  ViewSamplingParams params;
+  params.radii = {0.4f, 0.4f, 1.f};
+  params.full_turn_within_deg = 40.f;
+  const auto views = sampleViews(params, Eigen::Vector3f::Zero());
+  std::map<int, std::set<float>> turns;
+  for (const TrainingView& v : views) turns[v.viewpoint].insert(v.inplane_deg);
+  const auto dirs = sphereViewpoints(params.viewpoints, false);
+  for (const auto& [viewpoint, angles] : turns) {
+    const bool near_pole = dirs[static_cast<std::size_t>(viewpoint)].z() >= std::cos(40.f * 3.14159265f / 180.f);
+    EXPECT_EQ(angles.size(), near_pole ? 36u : 13u) << viewpoint;
+  }
+  ViewSamplingParams paper = params;
+  paper.full_turn_within_deg = 0.f;
+  const auto paper_views = sampleViews(paper, Eigen::Vector3f::Zero());
+  EXPECT_EQ(paper_views.size(), 216u * 13u);
+  EXPECT_GT(views.size(), paper_views.size());
+
+  // Cameras within 30 degrees of the top at every turn: the nearest view's rotation.
+  const auto nearest = [](const std::vector<TrainingView>& vs, const Eigen::Matrix3f& R) {
+    float best = 180.f;
+    for (const TrainingView& v : vs)
+      best = std::min(best, std::acos(std::clamp(((v.R.transpose() * R).trace() - 1.f) / 2.f, -1.f, 1.f)) * 180.f /
+                                3.14159265f);
+    return best;
+  };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> polar(0.f, 30.f), azimuth(0.f, 360.f), turn(-180.f, 180.f);
+  float worst_whole = 0.f, worst_paper = 0.f;
+  for (int i = 0; i < 60; ++i) {
+    const float p = polar(rng) * 3.14159265f / 180.f, a = azimuth(rng) * 3.14159265f / 180.f;
+    const Eigen::Vector3f dir(std::sin(p) * std::cos(a), std::sin(p) * std::sin(a), std::cos(p));
+    const Eigen::Matrix3f R = lookAtView(dir, Eigen::Vector3f::Zero(), 0.4f, turn(rng)).R;
+    worst_whole = std::max(worst_whole, nearest(views, R));
+    worst_paper = std::max(worst_paper, nearest(paper_views, R));
+  }
+  EXPECT_LT(worst_whole, 10.f);  // the lattice's spacing (about 10 degrees) and the 10-degree step
+  EXPECT_GT(worst_paper, 25.f);  // 34 degrees with this seed
+
+  params.full_turn_within_deg = 91.f;
+  EXPECT_THROW(validateViewSampling(params), InputError);
+  params.full_turn_within_deg = -1.f;
+  EXPECT_THROW(validateViewSampling(params), InputError);
+  params.full_turn_within_deg = 40.f;
+  params.inplane_deg = {0.f, 0.05f, 0.01f};
+  EXPECT_THROW(validateViewSampling(params), InputError);
+}
+
+// dropTurnsShownAlready keeps the whole turn's views that no view of the range shows (they
+// fill the gaps) and drops the rest. A near-symmetry drops more: a hex nut's 60 degrees about
+// its up axis turns the views nearest the pole into one another (farther from it, a turn about
+// the up axis moves the camera round the axis rather than turning the image).
+TEST(ViewSampling, TurnsShownAlreadyAreDroppedAndTheGapsStayFilled) {
+  ViewSamplingParams params;
+  params.radii = {0.4f, 0.5f, 0.1f};
+  params.full_turn_within_deg = 40.f;
+  const auto views = sampleViews(params, Eigen::Vector3f::Zero());
+  const auto in_range = [](const TrainingView& v) { return v.inplane_deg >= -60.f && v.inplane_deg <= 60.f; };
+  const auto angle = [](const Eigen::Matrix3f& a, const Eigen::Matrix3f& b) {
+    return std::acos(std::clamp(((a.transpose() * b).trace() - 1.f) / 2.f, -1.f, 1.f)) * 180.f / 3.14159265f;
+  };
+  std::vector<Eigen::Matrix3f> range;
+  for (const TrainingView& v : views)
+    if (in_range(v)) range.push_back(v.R);
+  const auto nearest_in_range = [&](const Eigen::Matrix3f& R) {
+    float best = 180.f;
+    for (const Eigen::Matrix3f& b : range) best = std::min(best, angle(b, R));
+    return best;
+  };
+
+  const auto kept = dropTurnsShownAlready(views, params.inplane_deg, {}, 10.f);
+  std::size_t extras = 0, kept_extras = 0;
+  for (const TrainingView& v : views) extras += in_range(v) ? 0 : 1;
+  for (const TrainingView& v : kept) {
+    if (in_range(v)) continue;
+    ++kept_extras;
+    EXPECT_GE(nearest_in_range(v.R), 10.f - 1e-2f) << v.viewpoint << " " << v.inplane_deg;  // a gap it fills
+  }
+  EXPECT_EQ(kept.size() - kept_extras, range.size());  // the range is never touched
+  EXPECT_GT(kept_extras, 0u);
+  EXPECT_LT(kept_extras, extras);
+  // What was dropped is within the tolerance of a view of the range.
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < views.size() && checked < 40; i += 7) {
+    if (in_range(views[i]) || std::any_of(kept.begin(), kept.end(), [&](const TrainingView& k) {
+          return k.viewpoint == views[i].viewpoint && k.inplane_deg == views[i].inplane_deg;
+        }))
+      continue;
+    EXPECT_LT(nearest_in_range(views[i].R), 10.f + 1e-2f);
+    ++checked;
+  }
+  EXPECT_GT(checked, 0u);
+
+  NearSymmetry hex;
+  hex.axis = Eigen::Vector3f::UnitZ();
+  hex.angle_deg = 60.f;
+  const auto nut = dropTurnsShownAlready(views, params.inplane_deg, {hex}, 10.f);
+  std::size_t nut_extras = 0;
+  for (const TrainingView& v : nut) nut_extras += in_range(v) ? 0 : 1;
+  EXPECT_LT(nut_extras, kept_extras);
+  EXPECT_EQ(nut.size() - nut_extras, range.size());
 }
 
 TEST(ViewSampling, RangesParseAndRejectNonsense) {

@@ -223,7 +223,11 @@ TEST(UpAxis, TrainingPlanTakesTheUpAxisFoundAndTrainsRestingPosesAsAsked) {
   EXPECT_EQ(names(automatic.views.other_ups), names(a.other_ups));
   for (const Eigen::Vector3f& u : a.other_ups) EXPECT_LT(u.dot(automatic.views.up), 0.99f);
   // Each hemisphere's views, the same as sampling them by hand.
-  EXPECT_EQ(a.views.size(), viewsAbove(sampleViews(automatic.views, brick.bboxCentre()), brick.bboxCentre(), 80.f).size());
+  const auto by_hand = dropTurnsShownAlready(sampleViews(automatic.views, brick.bboxCentre()),
+                                             automatic.views.inplane_deg,
+                                             findNearSymmetries(brick, automatic.near_symmetry_tolerance * brick.diameter),
+                                             fullTurnStep(automatic.views.inplane_deg));
+  EXPECT_EQ(a.views.size(), viewsAbove(by_hand, brick.bboxCentre(), 80.f).size());
   std::set<std::string> ups;
   for (const TrainingView& v : a.views) ups.insert(upAxisName(v.up));
   EXPECT_EQ(ups.size(), 1u + a.other_ups.size());
@@ -244,6 +248,20 @@ TEST(UpAxis, TrainingPlanTakesTheUpAxisFoundAndTrainsRestingPosesAsAsked) {
   const TrainingPlan f = plan(true, "all", true, sphere);
   EXPECT_TRUE(f.other_ups.empty());
   EXPECT_TRUE(sphere.views.other_ups.empty());
+
+  // A part in a bin is seen from above at any turn: the whole turn near each pole, unless the
+  // caller says otherwise; a standing part keeps the range.
+  EXPECT_FLOAT_EQ(automatic.views.full_turn_within_deg, kPileFullTurnWithinDeg);
+  EXPECT_FLOAT_EQ(standing.views.full_turn_within_deg, 0.f);
+  TrainingParams asked;
+  asked.views.viewpoints = 30;
+  asked.views.radii = {0.3f, 0.4f, 0.1f};
+  asked.views.inplane_deg = {0.f, 0.f, 10.f};
+  const TrainingPlan none = planTraining(brick, asked, true, "auto", 80.f, 0.f);
+  EXPECT_FLOAT_EQ(asked.views.full_turn_within_deg, 0.f);
+  EXPECT_LT(none.views.size(), a.views.size());
+  planTraining(brick, asked, true, "up", 80.f, 20.f);
+  EXPECT_FLOAT_EQ(asked.views.full_turn_within_deg, 20.f);
 
   TrainingParams bad;
   EXPECT_THROW(plan(true, "sideways", false, bad), InputError);
@@ -298,6 +316,7 @@ TEST(UpAxis, TheBankKeepsIt) {
   params.views.inplane_deg = {0.f, 0.f, 1.f};
   params.views.up = parseUpAxis("-y");
   params.views.other_ups = {parseUpAxis("+x")};
+  params.views.full_turn_within_deg = 25.f;  // none of the 3 viewpoints is that near a pole
   const TemplateBank bank = trainTemplates(test::context(), carton, params);
   const std::string path = (std::filesystem::temp_directory_path() / "vkpose_up_axis_test.vkpb").string();
   saveBank(bank, path);
@@ -306,6 +325,7 @@ TEST(UpAxis, TheBankKeepsIt) {
   EXPECT_EQ(upAxisName(back.params.views.up), "-y");
   ASSERT_EQ(back.params.views.other_ups.size(), 1u);
   EXPECT_EQ(upAxisName(back.params.views.other_ups[0]), "+x");
+  EXPECT_FLOAT_EQ(back.params.views.full_turn_within_deg, 25.f);
   // Every template was rendered from above -y, then from above +x.
   ASSERT_EQ(back.templates.size(), 6u);
   for (std::size_t i = 0; i < back.templates.size(); ++i) {
