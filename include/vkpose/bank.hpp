@@ -86,9 +86,9 @@ struct ViewSamplingParams {
 inline constexpr float kFullTurnSingleAngleStepDeg = 10.f;
 /// `inplane`'s step, or kFullTurnSingleAngleStepDeg where it holds one angle.
 float fullTurnStep(const SteppedRange& inplane);
-/// The in-plane rotations of a whole turn at fullTurnStep, centred on `inplane`'s middle
-/// (-60:60:10 gives -180 to 170): what views near a hemisphere's pole take
-/// (full_turn_within_deg).
+/// The in-plane rotations of a whole turn at fullTurnStep on `inplane`'s grid, from half a
+/// turn below its middle (-60:60:10 gives -180 to 170, and -180:170:10 itself): what views
+/// near a hemisphere's pole take (full_turn_within_deg).
 std::vector<float> fullTurnInPlane(const SteppedRange& inplane);
 
 /// Throws InputError when the counts or ranges are out of bounds (full_turn_within_deg outside

@@ -125,10 +125,13 @@ float fullTurnStep(const SteppedRange& inplane) {
 
 std::vector<float> fullTurnInPlane(const SteppedRange& inplane) {
   checkRange(inplane, "in-plane rotations");
-  const float start = 0.5f * (inplane.from + inplane.to) - 180.f;
+  // On the range's own grid (so the turn holds its angles), from half a turn below its middle.
   const float step = fullTurnStep(inplane);
+  const float lowest = 0.5f * (inplane.from + inplane.to) - 180.f;
+  const float start = inplane.from - step * std::floor((inplane.from - lowest) / step + 1e-4f);
   std::vector<float> out;
-  for (int i = 0; static_cast<float>(i) * step < 360.f - 1e-3f; ++i) out.push_back(start + static_cast<float>(i) * step);
+  for (int i = 0; start + static_cast<float>(i) * step < lowest + 360.f - 1e-3f; ++i)
+    out.push_back(start + static_cast<float>(i) * step);
   return out;
 }
 

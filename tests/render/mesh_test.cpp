@@ -207,8 +207,12 @@ TEST(ViewSampling, TheWholeTurnNearThePoleCoversAPartSeenFromAboveAtAnyTurn) {
   ASSERT_EQ(whole.size(), 36u);
   EXPECT_FLOAT_EQ(whole.front(), -180.f);
   EXPECT_FLOAT_EQ(whole.back(), 170.f);
-  EXPECT_EQ(fullTurnInPlane({0.f, 10.f, 7.f}).size(), 52u);  // 0 to 357: no step past the turn
-  EXPECT_EQ(fullTurnInPlane({0.f, 0.f, 1.f}).size(), 36u);   // one angle: every 10 degrees
+  EXPECT_EQ(fullTurnInPlane({-180.f, 170.f, 10.f}), (SteppedRange{-180.f, 170.f, 10.f}.values()));  // the range's own
+  const auto sevens = fullTurnInPlane({0.f, 10.f, 7.f});  // -175 to 182 on the grid of 0 and 7
+  ASSERT_EQ(sevens.size(), 52u);
+  EXPECT_NEAR(sevens.front(), -175.f, 1e-3f);
+  EXPECT_TRUE(std::any_of(sevens.begin(), sevens.end(), [](float a) { return std::abs(a - 7.f) < 1e-3f; }));
+  EXPECT_EQ(fullTurnInPlane({0.f, 0.f, 1.f}).size(), 36u);  // one angle: every 10 degrees
 
   ViewSamplingParams params;
   params.radii = {0.4f, 0.4f, 1.f};
