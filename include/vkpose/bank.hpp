@@ -92,7 +92,8 @@ float fullTurnStep(const SteppedRange& inplane);
 std::vector<float> fullTurnInPlane(const SteppedRange& inplane);
 
 /// Throws InputError when the counts or ranges are out of bounds (full_turn_within_deg outside
-/// 0 to 90), `up` or one of `other_ups` is not a unit vector, there are more than five other ups, or other ups come with the full sphere.
+/// 0 to 90), `up` or one of `other_ups` is not a unit vector, there are more than five other
+/// ups, or other ups come with the full sphere.
 void validateViewSampling(const ViewSamplingParams& params);
 
 // ---- the up axis -----------------------------------------------------------------------

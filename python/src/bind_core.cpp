@@ -234,7 +234,11 @@ void bindCore(py::module_& m) {
           valueError(fmt::format("max_view_angle: {} is not within 1..180 degrees", max_view_angle));
         std::optional<float> full_turn;
         if (!full_turn_within.is_none()) {
-          full_turn = full_turn_within.cast<float>();
+          try {
+            full_turn = full_turn_within.cast<float>();
+          } catch (const py::cast_error&) {
+            valueError("full_turn_within: a number of degrees, or None");
+          }
           if (!(*full_turn >= 0.f && *full_turn <= 90.f))
             valueError(fmt::format("full_turn_within: {} is not within 0..90 degrees", *full_turn));
         }
