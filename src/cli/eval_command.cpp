@@ -6,7 +6,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 #include <thread>
 
 #include <fmt/core.h>
@@ -109,14 +108,11 @@ std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)
     const std::map<int, TemplateBank>& banks, CopyCheck& check,
     std::function<void(const BopImage&, const LinemodFrame&, const DetectionResult&)> next) {
   const auto [bank_list, index] = banksInObjIdOrder(banks);
-  std::set<int> banked;
-  for (const auto& [obj_id, bank] : banks) banked.insert(obj_id);
-  return [bank_list, index, banked, &check, next](const BopImage& im, const LinemodFrame& frame,
-                                                  const DetectionResult& result) {
+  return [bank_list, index, &check, next](const BopImage& im, const LinemodFrame& frame, const DetectionResult& result) {
     const std::vector<ScaledCopy> copies = loadScaledCopies(im);
     check.copies += static_cast<int>(copies.size());
     check.banked_copies += static_cast<int>(
-        std::count_if(copies.begin(), copies.end(), [&](const ScaledCopy& c) { return banked.contains(c.obj_id); }));
+        std::count_if(copies.begin(), copies.end(), [&](const ScaledCopy& c) { return index->contains(c.obj_id); }));
     check.reported += scaledCopiesReported(copies, result.detections, *bank_list, *index, 0.5f);
     if (next) next(im, frame, result);
   };

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
 #include <utility>
-#include <numbers>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
