@@ -55,6 +55,10 @@ struct Detection {
   /// pose's outline sits on the object's edges; a look-alike's strays where the shapes differ).
   /// Picking asks for PickParams::min_outline_on_edges. NaN where not measured.
   float outline_on_edges = std::numeric_limits<float>::quiet_NaN();
+  /// How large the scene's silhouette around the pose's outline is, x the model's (depth steps
+  /// found along the outline's normals, fitted as a scaling about its centre): about 1 for the
+  /// part, 1.1-1.2 for a model fitted into a larger look-alike. NaN where not measured.
+  float silhouette_scale = std::numeric_limits<float>::quiet_NaN();
   /// Agreement (-1..1) of the rendered mesh's chromaticity with the frame's over the pixels
   /// where the pose fits the depth (appearanceAgreement): a correlation where the rendering
   /// shows several colours, a match of the colour itself where it shows one; 1 when not

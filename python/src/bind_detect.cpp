@@ -189,6 +189,7 @@ py::dict detectionDict(const Detection& d) {
   out["silhouette_support"] = tidy(d.silhouette_support);
   out["contour_edges"] = tidy(d.contour_edges);
   if (std::isfinite(d.outline_on_edges)) out["outline_on_edges"] = tidy(d.outline_on_edges);
+  if (std::isfinite(d.silhouette_scale)) out["silhouette_scale"] = tidy(d.silhouette_scale);
   out["colour_agreement"] = tidy(d.colour_agreement);
   out["colour_measured"] = d.colour_measured;
   out["icp_fitness"] = d.icp_fitness;
@@ -393,6 +394,13 @@ leaves the config as it was.)")
                                if (!std::isfinite(p.d.outline_on_edges)) return py::none();
                                return py::float_(tidy(p.d.outline_on_edges));
                              })
+      .def_property_readonly("silhouette_scale",
+                             [](const PyDetection& p) -> py::object {
+                               if (!std::isfinite(p.d.silhouette_scale)) return py::none();
+                               return py::float_(tidy(p.d.silhouette_scale));
+                             },
+                             "The scene's silhouette around the outline, times the model's (a larger look-alike: "
+                             "over 1); None where not measured")
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
                              "Correlation of the rendered mesh's chromaticity with the frame's; 1 when not measured")
       .def_property_readonly("colour_measured", [](const PyDetection& p) { return p.d.colour_measured; },

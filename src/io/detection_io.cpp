@@ -71,6 +71,7 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["silhouette_support"] = round(d.silhouette_support, 4);
     j["contour_edges"] = round(d.contour_edges, 4);
     if (std::isfinite(d.outline_on_edges)) j["outline_on_edges"] = round(d.outline_on_edges, 4);
+    if (std::isfinite(d.silhouette_scale)) j["silhouette_scale"] = round(d.silhouette_scale, 4);
     j["colour_agreement"] = round(d.colour_agreement, 4);
     j["colour_measured"] = d.colour_measured;
     j["icp_fitness"] = d.icp_fitness;  // m^2: tiny numbers, kept at full precision

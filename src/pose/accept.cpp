@@ -70,6 +70,7 @@ Detection fittedDetection(const PoseCandidate& c, const RefineResult& fit, const
   d.silhouette_support = e.silhouette_support;
   d.contour_edges = e.contour_edges;
   d.outline_on_edges = e.outline_on_edges;
+  d.silhouette_scale = e.silhouette_scale;
   d.score = poseScore(e);
   placeInImage(d, c.initial.model_points, bank.centre, camera);
   return d;
@@ -208,6 +209,10 @@ std::string stageEightShortfall(const PoseCandidate& c) {
     return fmt::format("only {:.0f}% of its visible outline lies on an image edge within 1.5 px (at least {:.0f}%): "
                        "something else of its size, or a pose off the part?",
                        100 * e.outline_on_edges, 100 * vp.min_outline_on_edges);
+  if (vp.max_silhouette_scale > 0.f && e.silhouette_scale > vp.max_silhouette_scale)
+    return fmt::format("the scene's silhouette around it is {:.0f}% larger than the model (at most {:.0f}%): a larger "
+                       "look-alike?",
+                       100 * (e.silhouette_scale - 1.f), 100 * (vp.max_silhouette_scale - 1.f));
   if (e.scaled_outline_support > e.outlineSupport() + vp.size_probe_margin)
     return fmt::format("its outline fits better 15% larger or smaller ({:.0f}% against {:.0f}% at its own size): "
                        "a look-alike of another size?",

@@ -160,6 +160,8 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 }
 
 VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank) {
+  const auto& radii = bank.params.views.radii;
+  if (!isSmallPart(bank.diameter) && std::min(radii.from, radii.to) >= kPileDistanceM) verify.max_silhouette_scale = 0.f;
   if (!isSmallPart(bank.diameter)) return verify;
   verify.min_colour_agreement = verify.small_part_min_colour_agreement;
   if (bank.symmetric || revolutionAxis(bank.near_symmetries))
@@ -413,6 +415,7 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
   e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit);
   e.contour_edges = contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump);
   e.outline_on_edges = outlineOnEdges(outline, frame.edges, frame.depth_m, params.silhouette_jump);
+  e.silhouette_scale = silhouetteScale(outline, frame.depth_m, params.silhouette_jump);
   if (with_cells) {
     e.explained = supportCells(model, frame.depth_m, frame.camera, params.see_through_tolerance);
     if (params.size_probe_margin < 1.f) e.scaled_outline_support = scaledOutlineSupport(model, frame, params);

@@ -73,6 +73,7 @@ struct PoseEvidence {
   /// explained better by another scale.
   float scaled_outline_support = 0.f;
   float outline_on_edges = 0.f;  ///< outlineOnEdges: how closely the outline lies on the image's edges
+  float silhouette_scale = 0.f;  ///< silhouetteScale: the scene's silhouette around the outline, x the model's
   /// The outline's support at the part's own size: contour edges and silhouette, averaged.
   float outlineSupport() const { return outlineSupport(contour_edges, silhouette_support); }
   /// The same average of any outline's two shares (the size probe's scaled models).
@@ -132,7 +133,8 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 /// Stage 8's tests as `bank`'s object gets them: a part under 10 cm asks more of its colour
 /// (small_part_min_colour_agreement), and one that is a body of revolution (trained
 /// --symmetric, or revolutionAxis() in its near-symmetries) more of its outline on the image's
-/// edges (small_turned_part_min_outline_on_edges); larger objects keep `verify`.
+/// edges (small_turned_part_min_outline_on_edges); larger objects keep `verify`. The size test
+/// (max_silhouette_scale) is for parts under 10 cm or trained nearer than kPileDistanceM only.
 VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank);
 
 /// Stage 6, translations: each start rendered in its own window (projectedWindow: one small

@@ -6,8 +6,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <vector>
 
+#include <Eigen/LU>
 #include <Eigen/Geometry>
 #include <fmt/core.h>
 #include <octomap/OcTree.h>
@@ -144,6 +146,64 @@ float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat
   const float counted = unhiddenShare(static_cast<float>(hidden) / static_cast<float>(usable), occlusion_credit);
   if (!(counted > 0.f)) return 0.f;  // all hidden, at a credit of 1: no step seen
   return static_cast<float>(steps) / (static_cast<float>(usable) * counted);
+}
+
+float silhouetteScale(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump,
+                      int max_px) {
+  CV_Assert(scene_depth_m.type() == CV_32FC1 && max_px > 0);
+  constexpr float kNotMeasured = std::numeric_limits<float>::quiet_NaN();
+  constexpr std::size_t kMinSamples = 24;
+  if (outline.size() < kMinSamples) return kNotMeasured;
+  Eigen::Vector2f centre = Eigen::Vector2f::Zero();
+  for (const OutlineSample& s : outline) centre += s.at;
+  centre /= static_cast<float>(outline.size());
+  // Per usable sample: how far outward the scene's surface runs on at the model's depth before
+  // it steps back (a hole, something nearer, or no step within max_px: not usable).
+  struct Row {
+    Eigen::Vector4f x;  // 1, radial distance along the normal, normal x, normal y
+    float d;
+  };
+  std::vector<Row> rows;
+  for (const OutlineSample& s : outline) {
+    if (!(s.model_z_in > 0.f)) continue;
+    const Eigen::Vector2f in = s.at - 3.f * s.out;
+    const float z_in = depthAt(scene_depth_m, in.x(), in.y());
+    if (!(z_in > 0.f) || hiddenByNearer(z_in, s.model_z_in, jump)) continue;
+    int step = -1;
+    for (int t = 0; t <= max_px; ++t) {
+      const Eigen::Vector2f q = s.at + static_cast<float>(t) * s.out;
+      const float z = depthAt(scene_depth_m, q.x(), q.y());
+      if (!(z > 0.f) || z < z_in - jump) break;  // a hole, the image's border or something nearer
+      if (z >= z_in + jump) {
+        step = t;
+        break;
+      }
+    }
+    if (step < 0) continue;
+    rows.push_back({Eigen::Vector4f(1.f, (s.at - centre).dot(s.out), s.out.x(), s.out.y()), static_cast<float>(step)});
+  }
+  if (rows.size() < kMinSamples) return kNotMeasured;
+  // d = margin + k * radial + shift . normal, by least squares: a model scaled by 1 + k about
+  // the outline's centre and moved by `shift` would meet the steps. Not a robust fit: the ends
+  // of a larger look-alike, where the outline falls short, are a minority of the samples that
+  // one would discount as outliers (a Huber fit at 2 px turned a 1.13 into 1.03 on one of eight
+  // starts of the same pose); clutter abutting the part is left out above instead.
+  Eigen::Matrix4f A = Eigen::Matrix4f::Zero();
+  Eigen::Vector4f y = Eigen::Vector4f::Zero();
+  for (const Row& r : rows) {
+    A += r.x * r.x.transpose();
+    y += r.d * r.x;
+  }
+  // The scaling shows only where the samples lie at different distances from the centre along
+  // their normals: a bar whose ends are hidden shows its sides alone (a wider margin looks the
+  // same as a larger part), one end and the sides a shift. What the radial distances leave
+  // unexplained by the margin and the shift must be 2 px RMS or more.
+  const Eigen::Matrix4f inverse = A.inverse();
+  if (!inverse.allFinite() || !(inverse(1, 1) > 0.f) || 1.f / (inverse(1, 1) * static_cast<float>(rows.size())) < 4.f)
+    return kNotMeasured;
+  const Eigen::Vector4f b = inverse * y;
+  if (!b.allFinite()) return kNotMeasured;
+  return 1.f + b(1);
 }
 
 ImageEdges imageEdges(const cv::Mat& bgr) {

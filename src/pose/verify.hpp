@@ -70,6 +70,16 @@ float silhouetteSupport(const PointCloud& model_points, const cv::Mat& scene_dep
                         float occlusion_credit = 0.f);
 float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump,
                         float occlusion_credit = 0.f);
+/// How large the scene's silhouette around a posed outline is, as a multiple of the model's:
+/// along each outline sample's normal, the distance at which the scene's depth steps back by
+/// `jump` (within `max_px`; samples behind something nearer, over holes or without a step are
+/// left out), fitted by least squares as a constant margin, a scaling about the outline's centre
+/// and a shift. A look-alike 10-20 % larger than the part, the model fitted into it, runs on past
+/// the outline by (scale - 1) x its distance from the centre: about 1.1-1.2; the right pose
+/// 1. NaN where fewer than 24 samples are usable, or where they cannot tell a scaling from a
+/// margin or a shift (both ends of a bar hidden, or one).
+float silhouetteScale(const std::vector<OutlineSample>& outline, const cv::Mat& scene_depth_m, float jump,
+                      int max_px = 40);
 
 /// The scene image's intensity gradients (Sobel of the lightly blurred grey image), computed
 /// once a frame for contourEdgeSupport.

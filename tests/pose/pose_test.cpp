@@ -2,6 +2,7 @@
 // the group mean, the viewing-ray correction, and the centroid translation against renderings
 // with a known offset, an occluder and a black hole. Stage 7's first fit: which starts go on.
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <Eigen/Geometry>
@@ -363,6 +364,27 @@ TEST(StageEight, TheOutlineOnEdgesTestIsOffUntilAsked) {
       << stageEightShortfall(c);
   c.evidence.outline_on_edges = 0.8f;
   EXPECT_EQ(stageEightShortfall(c), "");
+}
+
+// The size test (silhouette_scale) is off until asked, then for parts under 10 cm or trained
+// nearer than 0.5 m only; a scale not measured (NaN) passes.
+TEST(StageEight, TheSizeTestIsOffUntilAskedAndForCloseRangeParts) {
+  PoseCandidate c;
+  measure(c, true);
+  c.evidence.silhouette_scale = 1.13f;
+  EXPECT_EQ(stageEightShortfall(c), "") << "off by default";
+  TemplateBank key;  // 17 cm, trained at 0.3-0.5 m
+  key.diameter = 0.17f;
+  key.params.views.radii = {0.3f, 0.5f, 0.05f};
+  VerifyParams asked;
+  asked.max_silhouette_scale = 1.06f;
+  c.verify = partVerifyParams(asked, key);
+  EXPECT_NE(stageEightShortfall(c).find("silhouette around it is 13% larger than the model"), std::string::npos)
+      << stageEightShortfall(c);
+  c.evidence.silhouette_scale = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(stageEightShortfall(c), "");
+  key.params.views.radii = {0.6f, 1.2f, 0.1f};  // seen from farther: its outline spans too few pixels
+  EXPECT_EQ(partVerifyParams(asked, key).max_silhouette_scale, 0.f);
 }
 
 // A part under 10 cm asks more of its colour; one that is a body of revolution (a nozzle, a

@@ -353,5 +353,44 @@ TEST(Verify, TheOutlineLiesOnTheImagesEdgesWhenThePoseIsRight) {
   EXPECT_GT(outlineOnEdges(outline, imageEdges(striped_bgr), part_depth, 0.01f), 0.9f);
 }
 
+// The size test (silhouetteScale): a bar 100 x 20 px lies 1 m away, 20 cm in front of the
+// floor. Its own outline meets the depth steps all around: scale 1. A model 13 % smaller fitted
+// into it (centred, or laid against one end as ICP does) meets them only after running on by
+// 15 % of its distance from its centre: 1/0.87 = 1.15. What hides the bar (something nearer) or
+// abuts it is left out; where what is left cannot tell a scaling from a shift or a margin (an
+// end hidden), or nothing is usable, it is not measured.
+TEST(Verify, TheSilhouetteAroundALookAlikeIsLargerThanTheModel) {
+  const Camera camera = smallCamera(160, 120, 150.0);
+  const auto outlineOf = [&](cv::Rect r, const cv::Mat& depth) {
+    PointCloud points;
+    for (int v = r.y; v < r.y + r.height; ++v)
+      for (int u = r.x; u < r.x + r.width; ++u)
+        points.emplace_back(static_cast<float>((u - camera.cx) / camera.fx), static_cast<float>((v - camera.cy) / camera.fy), 1.f);
+    return outlineSamples(points, camera, depth.size());
+  };
+  const cv::Rect bar(30, 50, 100, 20), centred(37, 51, 87, 17), at_one_end(30, 51, 87, 17);
+  cv::Mat depth(120, 160, CV_32FC1, cv::Scalar(1.2f));
+  depth(bar).setTo(1.0f);
+  EXPECT_NEAR(silhouetteScale(outlineOf(bar, depth), depth, 0.01f), 1.f, 0.03f) << "the part itself";
+  EXPECT_NEAR(silhouetteScale(outlineOf(centred, depth), depth, 0.01f), 1.15f, 0.04f) << "13 % smaller, centred";
+  EXPECT_NEAR(silhouetteScale(outlineOf(at_one_end, depth), depth, 0.01f), 1.15f, 0.04f) << "13 % smaller, at one end";
+  // A part abutting the lower half of its right end at the same depth: no step within reach
+  // there, so those samples are left out, and the rest still tell the sizes apart.
+  cv::Mat abutting = depth.clone();
+  abutting(cv::Rect(130, 60, 30, 30)).setTo(1.0f);
+  EXPECT_NEAR(silhouetteScale(outlineOf(bar, abutting), abutting, 0.01f), 1.f, 0.03f);
+  EXPECT_NEAR(silhouetteScale(outlineOf(at_one_end, abutting), abutting, 0.01f), 1.15f, 0.05f);
+  // Its left end under something nearer: one end and the sides cannot tell a longer part from
+  // a shifted one, nor (both ends hidden) a wider margin from a larger part.
+  cv::Mat one_end = depth.clone();
+  one_end(cv::Rect(0, 0, 40, 120)).setTo(0.8f);
+  EXPECT_TRUE(std::isnan(silhouetteScale(outlineOf(bar, one_end), one_end, 0.01f)));
+  cv::Mat sides_only = one_end.clone();
+  sides_only(cv::Rect(120, 0, 40, 120)).setTo(0.8f);
+  EXPECT_TRUE(std::isnan(silhouetteScale(outlineOf(bar, sides_only), sides_only, 0.01f)));
+  const cv::Mat holes(120, 160, CV_32FC1, cv::Scalar(0.f));
+  EXPECT_TRUE(std::isnan(silhouetteScale(outlineOf(bar, holes), holes, 0.01f))) << "no depth";
+}
+
 }  // namespace
 }  // namespace vkpose
