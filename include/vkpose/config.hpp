@@ -313,12 +313,12 @@ struct VerifyParams {
   /// Size from the depth around the outline (silhouetteScale): along each visible outline
   /// sample's normal, where the scene's depth steps back, fitted as a scaling of the outline
   /// about its centre. A model fitted into a look-alike 10-20 % larger meets those steps only
-  /// past its own outline (the metal piles' larger spark-plug keys: 1.08-1.13 at most starts),
+  /// past its own outline (the metal piles' larger spark-plug keys: 1.08-1.17 at most starts),
   /// the part's own pose at about 1. With a limit above 1, reject above it, for parts under
   /// kSmallPartDiameterM or trained nearer than kPileDistanceM only (partVerifyParams), where
   /// the outline spans enough pixels of a close camera's depth. Off by default: the estimate
   /// moves with the holes in a metal part's depth (starts of one copy's pose, 0.5 mm apart,
-  /// gave 1.06 and 1.10-1.17) and right poses reach 1.10 (history.md). 0: off.
+  /// gave 1.06 and 1.10-1.17) and right poses reach 1.14 (history.md). 0: off.
   float max_silhouette_scale = 0.f;
   /// Objects compete for scene points: best score first, each accepted detection claims the
   /// scene it explains (4 x 4 pixel cells where a visible model point meets the scene depth

@@ -9,8 +9,8 @@
 #include <limits>
 #include <vector>
 
-#include <Eigen/LU>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <fmt/core.h>
 #include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
@@ -187,7 +187,8 @@ float silhouetteScale(const std::vector<OutlineSample>& outline, const cv::Mat& 
   // the outline's centre and moved by `shift` would meet the steps. Not a robust fit: the ends
   // of a larger look-alike, where the outline falls short, are a minority of the samples that
   // one would discount as outliers (a Huber fit at 2 px turned a 1.13 into 1.03 on one of eight
-  // starts of the same pose); clutter abutting the part is left out above instead.
+  // starts of the same pose); clutter abutting the part with no step within max_px is left out
+  // above instead.
   Eigen::Matrix4f A = Eigen::Matrix4f::Zero();
   Eigen::Vector4f y = Eigen::Vector4f::Zero();
   for (const Row& r : rows) {
