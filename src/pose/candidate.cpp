@@ -415,8 +415,8 @@ PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const
   e.silhouette_support = silhouetteSupport(outline, frame.depth_m, params.silhouette_jump, params.occlusion_credit);
   e.contour_edges = contourEdgeSupport(outline, frame.edges, frame.depth_m, params.silhouette_jump);
   e.outline_on_edges = outlineOnEdges(outline, frame.edges, frame.depth_m, params.silhouette_jump);
-  e.silhouette_scale = silhouetteScale(outline, frame.depth_m, params.silhouette_jump);
   if (with_cells) {
+    e.silhouette_scale = silhouetteScale(outline, frame.depth_m, params.silhouette_jump);
     e.explained = supportCells(model, frame.depth_m, frame.camera, params.see_through_tolerance);
     if (params.size_probe_margin < 1.f) e.scaled_outline_support = scaledOutlineSupport(model, frame, params);
   }

@@ -73,7 +73,9 @@ struct PoseEvidence {
   /// explained better by another scale.
   float scaled_outline_support = 0.f;
   float outline_on_edges = 0.f;  ///< outlineOnEdges: how closely the outline lies on the image's edges
-  float silhouette_scale = 0.f;  ///< silhouetteScale: the scene's silhouette around the outline, x the model's
+  /// silhouetteScale: the scene's silhouette around the outline, times the model's (stage 8 only:
+  /// no first-fit test reads it; NaN where not measured).
+  float silhouette_scale = std::numeric_limits<float>::quiet_NaN();
   /// The outline's support at the part's own size: contour edges and silhouette, averaged.
   float outlineSupport() const { return outlineSupport(contour_edges, silhouette_support); }
   /// The same average of any outline's two shares (the size probe's scaled models).
@@ -183,7 +185,8 @@ void refineCandidates(std::vector<PoseCandidate>& candidates, const std::vector<
                       unsigned threads);
 
 /// Stage 8's measurements of `model_points` (object frame) at `pose` against the scene; the
-/// scene cells it explains (PoseEvidence::explained) only with `with_cells`.
+/// scene cells it explains (PoseEvidence::explained) and the size tests only with `with_cells`
+/// (the first fits' screen reads neither).
 PoseEvidence measurePose(const PointCloud& model_points, const Pose& pose, const PointCloud& scene_points,
                          const PoseFrame& frame, const VerifyParams& params, bool with_cells = true);
 
