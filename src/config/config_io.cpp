@@ -122,7 +122,7 @@ std::vector<ConfigField> verifyFields(DetectorParams& p) {
       {"verify", "silhouette_jump", "a depth step this large marks the outline, metres", &p.verify.silhouette_jump, above(0)},
       {"verify", "min_silhouette_support", "share of the outline that must show a depth step, 0..1", &p.verify.min_silhouette_support, closed(0, 1)},
       {"verify", "min_contour_edges", "share of the visible outline that must meet an image edge, 0..1 (0: off)", &p.verify.min_contour_edges, closed(0, 1)},
-      {"verify", "max_silhouette_scale", "reject when the scene's silhouette around the outline is more than this many times the model's (parts trained nearer than 0.5 m or under 10 cm; 0: off, the default)", &p.verify.max_silhouette_scale, closed(0, 2)},
+      {"verify", "max_silhouette_scale", "reject when the scene's silhouette around the outline is more than this many times the model's (parts of 10 cm or more trained nearer than 0.5 m; 0: off)", &p.verify.max_silhouette_scale, closed(0, 2)},
       {"verify", "size_probe_margin", "reject when the model scaled by 1/1.15 or 1.15 explains the outline better than at its own size by more than this, 0..1 (1: off)", &p.verify.size_probe_margin, closed(0, 1)},
       {"verify", "max_shared_support", "share of its scene support a better detection may already claim, 0..1", &p.verify.max_shared_support, closed(0, 1)},
       {"verify", "resolve_symmetries", "render a pose's near-symmetric alternatives and keep the one colour and depth favour", &p.verify.resolve_symmetries},

@@ -161,7 +161,7 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 
 VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank) {
   const auto& radii = bank.params.views.radii;
-  if (!isSmallPart(bank.diameter) && std::min(radii.from, radii.to) >= kPileDistanceM) verify.max_silhouette_scale = 0.f;
+  if (isSmallPart(bank.diameter) || std::min(radii.from, radii.to) >= kPileDistanceM) verify.max_silhouette_scale = 0.f;
   if (!isSmallPart(bank.diameter)) return verify;
   verify.min_colour_agreement = verify.small_part_min_colour_agreement;
   if (bank.symmetric || revolutionAxis(bank.near_symmetries))

@@ -136,7 +136,7 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 /// (small_part_min_colour_agreement), and one that is a body of revolution (trained
 /// --symmetric, or revolutionAxis() in its near-symmetries) more of its outline on the image's
 /// edges (small_turned_part_min_outline_on_edges); larger objects keep `verify`. The size test
-/// (max_silhouette_scale) is for parts under 10 cm or trained nearer than kPileDistanceM only.
+/// (max_silhouette_scale) is for parts of 10 cm or more trained nearer than kPileDistanceM only.
 VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank);
 
 /// Stage 6, translations: each start rendered in its own window (projectedWindow: one small

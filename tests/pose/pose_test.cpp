@@ -366,25 +366,31 @@ TEST(StageEight, TheOutlineOnEdgesTestIsOffUntilAsked) {
   EXPECT_EQ(stageEightShortfall(c), "");
 }
 
-// The size test (silhouette_scale) is off until asked, then for parts under 10 cm or trained
-// nearer than 0.5 m only; a scale not measured (NaN) passes.
-TEST(StageEight, TheSizeTestIsOffUntilAskedAndForCloseRangeParts) {
+// The size test (silhouette_scale) is for parts of 10 cm or more trained nearer than 0.5 m (a
+// spark-plug key in a pile): not for a part under 10 cm (its holed depth moves the estimate),
+// nor for one trained farther; a scale not measured (NaN) passes.
+TEST(StageEight, TheSizeTestIsForLargePartsTrainedAtCloseRange) {
   PoseCandidate c;
   measure(c, true);
   c.evidence.silhouette_scale = 1.13f;
-  EXPECT_EQ(stageEightShortfall(c), "") << "off by default";
   TemplateBank key;  // 17 cm, trained at 0.3-0.5 m
   key.diameter = 0.17f;
   key.params.views.radii = {0.3f, 0.5f, 0.05f};
-  VerifyParams asked;
-  asked.max_silhouette_scale = 1.06f;
-  c.verify = partVerifyParams(asked, key);
+  const VerifyParams defaults;
+  EXPECT_FLOAT_EQ(defaults.max_silhouette_scale, 1.05f);
+  c.verify = partVerifyParams(defaults, key);
   EXPECT_NE(stageEightShortfall(c).find("silhouette around it is 13% larger than the model"), std::string::npos)
       << stageEightShortfall(c);
+  c.evidence.silhouette_scale = 1.04f;
+  EXPECT_EQ(stageEightShortfall(c), "");
   c.evidence.silhouette_scale = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(stageEightShortfall(c), "");
   key.params.views.radii = {0.6f, 1.2f, 0.1f};  // seen from farther: its outline spans too few pixels
-  EXPECT_EQ(partVerifyParams(asked, key).max_silhouette_scale, 0.f);
+  EXPECT_EQ(partVerifyParams(defaults, key).max_silhouette_scale, 0.f);
+  TemplateBank nozzle = key;  // 58 mm, trained at 0.3-0.5 m
+  nozzle.diameter = 0.058f;
+  nozzle.params.views.radii = {0.3f, 0.5f, 0.05f};
+  EXPECT_EQ(partVerifyParams(defaults, nozzle).max_silhouette_scale, 0.f);
 }
 
 // A part under 10 cm asks more of its colour; one that is a body of revolution (a nozzle, a
