@@ -18,7 +18,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 vkpose="${VKPOSE:-$root/build/release/vkpose}"
-[ $# -ge 1 ] || { sed -n 2,16p "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n 2,17p "$0"; exit 2; }
 out="$1"; shift
 seeds=("${@:-61 62}")
 copies="${COPIES:-0}"
