@@ -30,6 +30,17 @@ float depthAt(const cv::Mat& depth_m, float x, float y) {
   return depth_m.at<float>(v, u);
 }
 
+/// How far inside the outline a sample reads depth: the model's in outlineSamples
+/// (OutlineSample::model_z_in), the scene's in sceneDepthInside. hiddenByNearer compares the
+/// two, so they must be read at the same pixel.
+constexpr float kInsideProbePx = 3.f;
+
+/// The scene's depth kInsideProbePx inside an outline sample (0: none).
+float sceneDepthInside(const OutlineSample& sample, const cv::Mat& scene_depth_m) {
+  const Eigen::Vector2f in = sample.at - kInsideProbePx * sample.out;
+  return depthAt(scene_depth_m, in.x(), in.y());
+}
+
 /// Whether the scene just inside an outline sample (`z_in`, 0: no depth) lies `jump` or more in
 /// front of the model there (`model_z_in`, 0: unknown): something nearer hides that stretch.
 bool hiddenByNearer(float z_in, float model_z_in, float jump) {
@@ -42,8 +53,8 @@ bool hiddenByNearer(float z_in, float model_z_in, float jump) {
 /// (the image's border is no edge of the object's).
 bool edgeSampleUsable(const OutlineSample& sample, const cv::Mat& scene_depth_m, float jump, float border) {
   const auto& [c, normal, model_z_in] = sample;
-  const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-  const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+  const Eigen::Vector2f out = c + 4.f * normal;
+  const float z_in = sceneDepthInside(sample, scene_depth_m), z_out = depthAt(scene_depth_m, out.x(), out.y());
   if (hiddenByNearer(z_in, model_z_in, jump)) return false;
   if (z_in > 0.f && z_out > 0.f && z_out < z_in - jump) return false;
   return c.x() >= border && c.y() >= border && c.x() < float(scene_depth_m.cols) - border &&
@@ -97,9 +108,9 @@ std::vector<OutlineSample> outlineSamples(const PointCloud& model_points, const 
       const Eigen::Vector2f probe = c + 2.f * normal;
       const int pu = static_cast<int>(std::lround(probe.x())), pv = static_cast<int>(std::lround(probe.y()));
       if (pu >= 0 && pv >= 0 && pu < mask.cols && pv < mask.rows && mask.at<uint8_t>(pv, pu)) normal = -normal;
-      // The model's depth inside: at the probe 3 px in, or the nearest point of the 5 x 5
-      // pixels around it (the points are one a rendered pixel, with gaps).
-      const Eigen::Vector2f in = c - 3.f * normal;
+      // The model's depth inside: at the probe kInsideProbePx in, or the nearest point of the
+      // 5 x 5 pixels around it (the points are one a rendered pixel, with gaps).
+      const Eigen::Vector2f in = c - kInsideProbePx * normal;
       const int iu = static_cast<int>(std::lround(in.x())), iv = static_cast<int>(std::lround(in.y()));
       float z_in = 0.f;
       for (int dv = -2; dv <= 2; ++dv)
@@ -129,9 +140,10 @@ float silhouetteSupport(const std::vector<OutlineSample>& outline, const cv::Mat
                         float occlusion_credit) {
   CV_Assert(scene_depth_m.type() == CV_32FC1);
   std::size_t steps = 0, usable = 0, hidden = 0;
-  for (const auto& [c, normal, model_z_in] : outline) {
-    const Eigen::Vector2f in = c - 3.f * normal, out = c + 4.f * normal;
-    const float z_in = depthAt(scene_depth_m, in.x(), in.y()), z_out = depthAt(scene_depth_m, out.x(), out.y());
+  for (const OutlineSample& sample : outline) {
+    const auto& [c, normal, model_z_in] = sample;
+    const Eigen::Vector2f out = c + 4.f * normal;
+    const float z_in = sceneDepthInside(sample, scene_depth_m), z_out = depthAt(scene_depth_m, out.x(), out.y());
     if (!(z_in > 0.f) || !(z_out > 0.f) || z_out < z_in - jump) continue;
     ++usable;
     // Behind something nearer (the scene inside the outline lies in front of the model): no
@@ -166,8 +178,7 @@ float silhouetteScale(const std::vector<OutlineSample>& outline, const cv::Mat& 
   std::vector<Row> rows;
   for (const OutlineSample& s : outline) {
     if (!(s.model_z_in > 0.f)) continue;
-    const Eigen::Vector2f in = s.at - 3.f * s.out;
-    const float z_in = depthAt(scene_depth_m, in.x(), in.y());
+    const float z_in = sceneDepthInside(s, scene_depth_m);
     if (!(z_in > 0.f) || hiddenByNearer(z_in, s.model_z_in, jump)) continue;
     int step = -1;
     for (int t = 0; t <= max_px; ++t) {
