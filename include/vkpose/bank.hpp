@@ -35,6 +35,9 @@ struct SteppedRange {
     for (int i = 0; i < n; ++i) out.push_back(from + static_cast<float>(i) * step);
     return out;
   }
+  /// The lower end, whichever way round the range was given (radii: the nearest distance
+  /// trained, which the pile rules read).
+  float low() const { return std::min(from, to); }
 };
 
 /// Parses "A:B:STEP" (or a single value "A"); throws InputError on nonsense.

@@ -66,7 +66,7 @@ void printPlan(const TrainingPlan& plan, const TrainingParams& params, const Mes
                                  isSmallPart(mesh.diameter)
                                      ? fmt::format("a part {:.0f} mm across", 1e3f * mesh.diameter)
                                      : fmt::format("a part seen from {:.2f} m (nearer than {:.1f} m: bin picking)",
-                                                   std::min(params.views.radii.from, params.views.radii.to),
+                                                   params.views.radii.low(),
                                                    kPileDistanceM))
                : trained ? "a hemisphere of views about each as well"
                      : "not trained: pass --resting all to find it lying down too");

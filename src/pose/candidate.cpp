@@ -160,9 +160,9 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
 }
 
 VerifyParams partVerifyParams(VerifyParams verify, const TemplateBank& bank) {
-  const auto& radii = bank.params.views.radii;
-  if (isSmallPart(bank.diameter) || std::min(radii.from, radii.to) >= kPileDistanceM) verify.max_silhouette_scale = 0.f;
-  if (!isSmallPart(bank.diameter)) return verify;
+  const bool small = isSmallPart(bank.diameter);
+  if (small || bank.params.views.radii.low() >= kPileDistanceM) verify.max_silhouette_scale = 0.f;
+  if (!small) return verify;
   verify.min_colour_agreement = verify.small_part_min_colour_agreement;
   if (bank.symmetric || revolutionAxis(bank.near_symmetries))
     verify.min_outline_on_edges = std::max(verify.min_outline_on_edges, verify.small_turned_part_min_outline_on_edges);

@@ -40,7 +40,7 @@ PartSizeEvidence partSizeEvidence(const Mesh& mesh, const TrainingParams& params
   std::sort(extent.data(), extent.data() + 3);
   e.thinnest_m = extent[0];
   e.width_m = extent[1];
-  e.nearest_m = std::min(params.views.radii.from, params.views.radii.to);
+  e.nearest_m = params.views.radii.low();
   e.farthest_m = std::max(params.views.radii.from, params.views.radii.to);
   const float f = 0.5f * static_cast<float>(params.camera.fx + params.camera.fy);
   const float cell = static_cast<float>(coarseCellPixels(params));

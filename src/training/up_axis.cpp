@@ -194,7 +194,7 @@ TrainingPlan planTraining(const Mesh& mesh, TrainingParams& params, bool auto_up
                           float max_view_angle_deg, std::optional<float> full_turn_within_deg) {
   TrainingPlan plan;
   const bool trains_others =  // throws first on a bad name
-      trainsOtherRestingPoses(resting, mesh.diameter, std::min(params.views.radii.from, params.views.radii.to));
+      trainsOtherRestingPoses(resting, mesh.diameter, params.views.radii.low());
   plan.found = findUpAxis(mesh);
   if (auto_up) params.views.up = plan.found.up;
   params.views.other_ups.clear();
