@@ -447,6 +447,21 @@ struct ColourOnlyParams {
   /// place or clutter, which agree 0.0-0.2, where right poses agree 0.5-0.97 on synthetic sets
   /// and 0.26-0.72 on LM-O's scanned colours.
   float min_colour_agreement = 0.2f;
+  /// The same for meshes whose colours vary (a painted or printed part: chromaticity spread
+  /// kMinChromaSpread or more), whose right poses show their pattern: on synthetic painted
+  /// cartons and cups, right poses agree 0.64-0.97, poses on other objects and clutter up to
+  /// 0.5. LM-O's scans vary too little for that (right poses 0.40-0.72) and keep the value
+  /// above. Table and bin sets looked at: precision 0.45 -> 0.64 and 0.51 -> 0.75.
+  float min_colourful_agreement = 0.5f;
+  /// Each fitted pose whose outline passed is fitted again (the finer rounds) from its
+  /// object's look-alike turns: the bank's near-symmetries where the mesh's colours tell them
+  /// apart (a painted carton turned a quarter about its axis has the same outline) and the
+  /// look-alike half-turns (VerifyParams::look_alike_tolerance); the best scored is kept.
+  bool try_turns = true;
+  /// ... and from the pose tilted by this angle both ways about the camera's x and y axes
+  /// through its centre (degrees; 0: off): the outline fit turns little out of the image
+  /// plane, and a start 15-30 degrees off stays there.
+  float tilt_restart_deg = 20.f;
 };
 
 struct DetectorParams {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
+#include <numeric>
 #include <optional>
 
 #include <fmt/format.h>
@@ -106,9 +108,8 @@ AppearanceAgreement colourAgreement(const Rendering& rendering, const cv::Rect& 
 
 void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                            const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
-                           const DetectorParams& params) {
+                           const DetectorParams& params, const ContourFitParams& fit_params) {
   const ColourOnlyParams& cp = params.colour_only;
-  const ContourFitParams fit_params;
   const std::size_t n = candidates.size();
   std::vector<Pose> poses(n);
   for (std::size_t i = 0; i < n; ++i) poses[i] = candidates[i].start;
@@ -166,9 +167,9 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         if (d.contour_edges < cp.min_contour_support)
           d.rejection = fmt::format("{:.0f} % of its outline meets an image edge, {:.0f} % needed",
                                     100.f * d.contour_edges, 100.f * cp.min_contour_support);
-        else if (colour_counts && cp.min_colour_agreement > -1.f && colour.colour < cp.min_colour_agreement)
-          d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour,
-                                    cp.min_colour_agreement);
+        else if (const float needed = objects[c.bank()].colourful ? cp.min_colourful_agreement : cp.min_colour_agreement;
+                 colour_counts && needed > -1.f && colour.colour < needed)
+          d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour, needed);
         d.verified = d.rejection.empty();
       },
       params.threads);
@@ -195,6 +196,61 @@ static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vec
     }
   }
   candidates = std::move(kept);
+}
+
+/// The turns of a pose that its templates cannot tell from it: the bank's near-symmetries where
+/// the mesh's colours can (a painted carton turned a quarter about its axis has the same
+/// outline), and the look-alike half-turns (a carton end for end). None for a symmetric bank.
+static std::vector<Pose> lookAlikeTurns(const PoseObject& object) {
+  std::vector<Pose> turns;
+  if (object.bank->symmetric) return turns;
+  if (object.colourful)
+    for (const NearSymmetry& s : object.bank->near_symmetries) turns.push_back(s.transform());
+  for (const NearSymmetry& s : object.look_alike_turns) turns.push_back(s.transform());
+  return turns;
+}
+
+std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object, const ColourOnlyParams& cp) {
+  std::vector<Pose> out;
+  if (cp.try_turns)
+    for (const Pose& turn : lookAlikeTurns(object)) out.push_back(compose(pose, turn));
+  if (cp.tilt_restart_deg > 0.f) {
+    const float angle = cp.tilt_restart_deg * static_cast<float>(M_PI / 180.0);
+    const Eigen::Vector3f centre = pose.R * object.bank->centre + pose.t;
+    for (const Eigen::Vector3f& axis : {Eigen::Vector3f(Eigen::Vector3f::UnitX()), Eigen::Vector3f(Eigen::Vector3f::UnitY())})
+      for (const float sign : {1.f, -1.f}) {
+        const Eigen::Matrix3f Q = Eigen::AngleAxisf(sign * angle, axis).toRotationMatrix();
+        out.push_back({Q * pose.R, Q * (pose.t - centre) + centre});
+      }
+  }
+  return out;
+}
+
+void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                       const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                       const DetectorParams& params, DetectionResult& result) {
+  const ColourOnlyParams& cp = params.colour_only;
+  std::vector<PoseCandidate> again;
+  std::vector<std::size_t> of(candidates.size());
+  std::iota(of.begin(), of.end(), std::size_t{0});
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Detection& d = candidates[i].detection;
+    if (!(d.score > 0.f) || d.contour_edges < cp.min_contour_support) continue;
+    for (const Pose& start : colourOnlyRestarts(d.pose, objects[candidates[i].bank()], cp)) {
+      PoseCandidate c = candidates[i];
+      c.start = start;
+      c.detection.rejection.clear();
+      c.detection.verified = false;
+      again.push_back(std::move(c));
+      of.push_back(i);
+    }
+  }
+  if (again.empty()) return;
+  ContourFitParams finer;
+  finer.truncation_px = {10.f, 5.f, 3.f};
+  fitAndVerifyByContour(again, objects, camera, bgr, maps, params, finer);
+  std::move(again.begin(), again.end(), std::back_inserter(candidates));
+  keepBestStart(candidates, of, result);
 }
 
 /// The accepted candidates, best score first, each unless a better one's centre projects
@@ -300,6 +356,7 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
   clock.end(Stage::contour_fit, result);
   keepBestStart(candidates, hypothesis_of, result);
+  refitFromRestarts(candidates, objects_, camera, frame.bgr, maps, params_, result);
   acceptByContour(candidates, banks_, camera, result);
   clock.end(Stage::verification, result);
   result.pose_wall_ms = msSince(wall0);

@@ -33,6 +33,21 @@ void scoreBySimilarity(std::vector<Hypothesis>& hypotheses);
 /// colour_agreement, verified, rejection). `camera`: the frame's; `bgr`: its colour image.
 void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                            const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
-                           const DetectorParams& params);
+                           const DetectorParams& params, const ContourFitParams& fit_params = {});
+
+/// Where a fitted pose is fitted again from: its object's look-alike turns
+/// (ColourOnlyParams::try_turns: the bank's near-symmetries where the mesh's colours tell them
+/// apart, and the look-alike half-turns; none for a symmetric bank), then the pose tilted by
+/// tilt_restart_deg both ways about the camera's x and y axes through the object's centre.
+std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object, const ColourOnlyParams& cp);
+
+/// Each candidate (one a hypothesis, fitted and verified) whose outline passed, fitted again
+/// from its restarts (the finer rounds: 10, 5 and 3 px) and verified; the best scored of each
+/// is kept, the others that passed go to `result.rejected`. A turn fits the outline as well as
+/// the pose, so the colours and inner edges choose; a tilt lets the fit leave a start 15-30
+/// degrees off out of the image plane, where the outline fit turns little.
+void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                       const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                       const DetectorParams& params, DetectionResult& result);
 
 }  // namespace vkpose

@@ -10,6 +10,7 @@
 #include "mesh_support.hpp"
 #include "pipeline/colour_only.hpp"
 #include "pose/contour_fit.hpp"
+#include "pose/appearance.hpp"
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
 #include "test_support.hpp"
@@ -132,6 +133,109 @@ TEST(ColourOnly, ABankWithoutTheColourModalityIsAClearError) {
   bank.params.features.use_colour = false;
   std::vector<int> ids;
   test::expectInputError([&] { (void)colourTemplates({bank}, ids); }, {"depth_only", "colour"});
+}
+
+/// A box of square section (a quarter-turn about its long axis fits the outline) whose corners
+/// are painted four ways around that axis, so colour tells the turns apart.
+struct PaintedBoxScene {
+  Mesh mesh = test::boxMesh({0.08f, 0.08f, 0.16f});
+  TemplateBank bank;
+  Camera camera;
+  Pose truth;
+  cv::Mat bgr;
+  PaintedBoxScene() {
+    for (const auto& v : mesh.vertices)
+      mesh.colours.emplace_back(v.x() > 0.f ? 0.9f : 0.1f, v.y() > 0.f ? 0.8f : 0.15f, 0.3f);
+    bank.object = "painted_box";
+    bank.mesh = mesh;
+    bank.diameter = mesh.diameter;
+    bank.params.views.radii = {0.5f, 0.8f, 0.1f};
+    bank.near_symmetries = findNearSymmetries(mesh, 0.01f * mesh.diameter);
+    truth.R = (Eigen::AngleAxisf(1.1f, Eigen::Vector3f::UnitX()) * Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitZ()))
+                  .toRotationMatrix();
+    truth.t = {0.02f, -0.01f, 0.6f};
+  }
+};
+
+TEST(ColourOnly, RestartsAreTheLookAlikeTurnsThenTiltsAboutTheCentre) {
+  PaintedBoxScene s;
+  ASSERT_GE(s.bank.near_symmetries.size(), 3u);  // 90, 180 and 270 degrees about z
+  PoseObject object;
+  object.bank = &s.bank;
+  object.colourful = meshChromaSpread(s.mesh) >= kMinChromaSpread;
+  ASSERT_TRUE(object.colourful);
+  ColourOnlyParams cp;
+  cp.tilt_restart_deg = 0.f;
+  const auto turns = colourOnlyRestarts(s.truth, object, cp);
+  ASSERT_EQ(turns.size(), s.bank.near_symmetries.size());
+  for (std::size_t k = 0; k < turns.size(); ++k)
+    EXPECT_LT((turns[k].R - s.truth.R * s.bank.near_symmetries[k].transform().R).norm(), 1e-5f);
+  // A mesh whose colours cannot tell the turns apart, or a symmetric bank: no turns.
+  object.colourful = false;
+  EXPECT_TRUE(colourOnlyRestarts(s.truth, object, cp).empty());
+  object.colourful = true;
+  s.bank.symmetric = true;
+  EXPECT_TRUE(colourOnlyRestarts(s.truth, object, cp).empty());
+  // Tilts: four, each the given angle, about an axis in the image plane, the centre kept.
+  cp.tilt_restart_deg = 20.f;
+  const auto tilts = colourOnlyRestarts(s.truth, object, cp);
+  ASSERT_EQ(tilts.size(), 4u);
+  for (const Pose& p : tilts) {
+    const Eigen::AngleAxisf turn(p.R * s.truth.R.transpose());
+    EXPECT_NEAR(turn.angle(), 20.f * static_cast<float>(M_PI / 180.0), 1e-4f);
+    EXPECT_NEAR(turn.axis().z(), 0.f, 1e-4f);
+    EXPECT_LT((p.t - s.truth.t).norm(), 1e-5f);  // the box's centre is its origin
+  }
+  cp.try_turns = false;
+  cp.tilt_restart_deg = 0.f;
+  EXPECT_TRUE(colourOnlyRestarts(s.truth, object, cp).empty());
+}
+
+TEST(ColourOnly, AQuarterTurnThatFitsTheOutlineIsFittedAgainAndTheColoursChooseTheTruth) {
+  PaintedBoxScene s;
+  MeshRenderer renderer(test::context(), s.mesh);
+  PoseObject object;
+  object.bank = &s.bank;
+  object.renderer = &renderer;
+  object.bounding_radius = 0.5f * s.mesh.diameter;
+  object.colourful = true;
+  const Rendering seen = renderer.render(s.camera, {s.truth}).front();
+  s.bgr = cv::Mat(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
+  seen.bgr.copyTo(s.bgr, seen.mask());
+  const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
+
+  // Stage 6 started it a quarter-turn about the box's axis off: the outline is the same.
+  const auto quarter = std::find_if(s.bank.near_symmetries.begin(), s.bank.near_symmetries.end(),
+                                    [](const NearSymmetry& n) { return std::abs(n.angle_deg - 90.f) < 1.f; });
+  ASSERT_NE(quarter, s.bank.near_symmetries.end());
+  PoseCandidate c;
+  c.detection.bank = 0;
+  c.detection.object = s.bank.object;
+  c.start = compose(s.truth, quarter->transform());
+  const Eigen::Vector2f at = s.camera.project(s.truth.t);
+  c.detection.x = at.x(), c.detection.y = at.y();
+  DetectorParams params;
+  params.colour_only.tilt_restart_deg = 0.f;
+  std::vector<PoseCandidate> candidates{c};
+  fitAndVerifyByContour(candidates, {object}, s.camera, s.bgr, maps, params);
+  const Detection& turned = candidates[0].detection;
+  EXPECT_GT(turned.contour_edges, 0.9f);  // the outline fits ...
+  EXPECT_FALSE(turned.verified);          // ... the colours do not
+  EXPECT_NE(turned.rejection.find("its colours agree"), std::string::npos) << turned.rejection;
+
+  DetectionResult result;
+  refitFromRestarts(candidates, {object}, s.camera, s.bgr, maps, params, result);
+  ASSERT_EQ(candidates.size(), 1u);
+  const Detection& d = candidates[0].detection;
+  EXPECT_TRUE(d.verified) << d.rejection;
+  EXPECT_GT(d.colour_agreement, 0.8f);
+  EXPECT_LT(proj2dError(s.mesh.vertices, d.pose.R, d.pose.t, s.truth.R, s.truth.t, s.camera), 1.5f);
+  // Without the turns it stays where it was.
+  params.colour_only.try_turns = false;
+  std::vector<PoseCandidate> alone{c};
+  fitAndVerifyByContour(alone, {object}, s.camera, s.bgr, maps, params);
+  refitFromRestarts(alone, {object}, s.camera, s.bgr, maps, params, result);
+  EXPECT_FALSE(alone[0].detection.verified);
 }
 
 }  // namespace
