@@ -241,6 +241,7 @@ void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector
       c.start = start;
       c.detection.rejection.clear();
       c.detection.verified = false;
+      c.cpu_ms = 0;
       again.push_back(std::move(c));
       of.push_back(i);
     }
@@ -249,6 +250,7 @@ void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector
   ContourFitParams finer;
   finer.truncation_px = {10.f, 5.f, 3.f};
   fitAndVerifyByContour(again, objects, camera, bgr, maps, params, finer);
+  for (const auto& c : again) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
   std::move(again.begin(), again.end(), std::back_inserter(candidates));
   keepBestStart(candidates, of, result);
 }
@@ -354,9 +356,9 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   clock.end(Stage::edges, result);
   fitAndVerifyByContour(candidates, objects_, camera, frame.bgr, maps, params_);
   for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
-  clock.end(Stage::contour_fit, result);
   keepBestStart(candidates, hypothesis_of, result);
   refitFromRestarts(candidates, objects_, camera, frame.bgr, maps, params_, result);
+  clock.end(Stage::contour_fit, result);
   acceptByContour(candidates, banks_, camera, result);
   clock.end(Stage::verification, result);
   result.pose_wall_ms = msSince(wall0);

@@ -43,7 +43,8 @@ std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object,
 
 /// Each candidate (one a hypothesis, fitted and verified) whose outline passed, fitted again
 /// from its restarts (the finer rounds: 10, 5 and 3 px) and verified; the best scored of each
-/// is kept, the others that passed go to `result.rejected`. A turn fits the outline as well as
+/// is kept, the others that passed go to `result.rejected`; the refits count in
+/// `result.refined_candidates` and `refine_cpu_ms`. A turn fits the outline as well as
 /// the pose, so the colours and inner edges choose; a tilt lets the fit leave a start 15-30
 /// degrees off out of the image plane, where the outline fit turns little.
 void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
