@@ -217,9 +217,9 @@ std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object,
   if (cp.tilt_restart_deg > 0.f) {
     const float angle = cp.tilt_restart_deg * static_cast<float>(M_PI / 180.0);
     const Eigen::Vector3f centre = pose.R * object.bank->centre + pose.t;
-    for (const Eigen::Vector3f& axis : {Eigen::Vector3f(Eigen::Vector3f::UnitX()), Eigen::Vector3f(Eigen::Vector3f::UnitY())})
+    for (const int axis : {0, 1})  // the camera's x and y
       for (const float sign : {1.f, -1.f}) {
-        const Eigen::Matrix3f Q = Eigen::AngleAxisf(sign * angle, axis).toRotationMatrix();
+        const Eigen::Matrix3f Q = Eigen::AngleAxisf(sign * angle, Eigen::Vector3f::Unit(axis)).toRotationMatrix();
         out.push_back({Q * pose.R, Q * (pose.t - centre) + centre});
       }
   }

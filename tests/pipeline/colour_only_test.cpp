@@ -9,8 +9,8 @@
 
 #include "mesh_support.hpp"
 #include "pipeline/colour_only.hpp"
-#include "pose/contour_fit.hpp"
 #include "pose/appearance.hpp"
+#include "pose/contour_fit.hpp"
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
 #include "test_support.hpp"
