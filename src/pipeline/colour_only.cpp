@@ -2,6 +2,7 @@
 #include "pipeline/colour_only.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -226,6 +227,80 @@ std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object,
   return out;
 }
 
+std::vector<Eigen::Matrix3f> colourTurns() {
+  std::vector<Eigen::Matrix3f> turns;
+  // The turns of a cube: the axes permuted, with the signs that keep the determinant +1.
+  std::array<int, 3> axes{0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3f Q = Eigen::Matrix3f::Zero();
+      for (int r = 0; r < 3; ++r) Q(r, axes[static_cast<std::size_t>(r)]) = (signs >> r & 1) ? -1.f : 1.f;
+      if (Q.determinant() > 0.f && !Q.isIdentity()) turns.push_back(Q);
+    }
+  } while (std::next_permutation(axes.begin(), axes.end()));
+  for (const int axis : {0, 1, 2})
+    for (const float deg : {45.f, 135.f, 225.f, 315.f})
+      turns.push_back(
+          Eigen::AngleAxisf(deg * static_cast<float>(M_PI / 180.0), Eigen::Vector3f::Unit(axis)).toRotationMatrix());
+  return turns;
+}
+
+/// For each candidate of a colourful object whose outline passed, its pose turned through the
+/// model's centre by each of colourTurns(), fitted one round and scored; the
+/// ColourOnlyParams::colour_turns best of each are appended to `again` as starts (`of`: the
+/// candidate each came from).
+static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                                const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                                const DetectorParams& params, DetectionResult& result,
+                                std::vector<PoseCandidate>& again, std::vector<std::size_t>& of) {
+  const ColourOnlyParams& cp = params.colour_only;
+  if (cp.colour_turns <= 0) return;
+  const std::vector<Eigen::Matrix3f> turns = colourTurns();
+  std::vector<PoseCandidate> screened;
+  std::vector<std::size_t> screened_of;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Detection& d = candidates[i].detection;
+    const PoseObject& object = objects[candidates[i].bank()];
+    if (!(d.score > 0.f) || d.contour_edges < cp.min_contour_support || !object.colourful || object.bank->symmetric)
+      continue;
+    const Eigen::Vector3f centre = object.bank->centre;
+    for (const Eigen::Matrix3f& Q : turns) {
+      PoseCandidate c = candidates[i];
+      c.start = compose(d.pose, Pose{Q, centre - Q * centre});
+      c.detection.rejection.clear();
+      c.detection.verified = false;
+      c.cpu_ms = 0;
+      screened.push_back(std::move(c));
+      screened_of.push_back(i);
+    }
+  }
+  if (screened.empty()) return;
+  ContourFitParams one_round;
+  one_round.truncation_px = {10.f};
+  fitAndVerifyByContour(screened, objects, camera, bgr, maps, params, one_round);
+  std::vector<std::vector<std::size_t>> of_candidate(candidates.size());
+  for (std::size_t k = 0; k < screened.size(); ++k) {
+    ++result.refined_candidates, result.refine_cpu_ms += screened[k].cpu_ms;
+    of_candidate[screened_of[k]].push_back(k);
+  }
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    std::vector<std::size_t>& ks = of_candidate[i];
+    std::stable_sort(ks.begin(), ks.end(), [&](std::size_t a, std::size_t b) {
+      return screened[a].detection.score > screened[b].detection.score;
+    });
+    for (std::size_t r = 0; r < std::min(ks.size(), static_cast<std::size_t>(cp.colour_turns)); ++r) {
+      PoseCandidate& c = screened[ks[r]];
+      if (!(c.detection.score > 0.f)) break;
+      c.start = c.detection.pose;  // on from where the screening round left it
+      c.detection.rejection.clear();
+      c.detection.verified = false;
+      c.cpu_ms = 0;
+      again.push_back(std::move(c));
+      of.push_back(i);
+    }
+  }
+}
+
 void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                        const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
                        const DetectorParams& params, DetectionResult& result) {
@@ -246,6 +321,7 @@ void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector
       of.push_back(i);
     }
   }
+  addColourTurnStarts(candidates, objects, camera, bgr, maps, params, result, again, of);
   if (again.empty()) return;
   ContourFitParams finer;
   finer.truncation_px = {10.f, 5.f, 3.f};

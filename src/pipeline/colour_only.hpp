@@ -41,12 +41,18 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
 /// tilt_restart_deg both ways about the camera's x and y axes through the object's centre.
 std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object, const ColourOnlyParams& cp);
 
+/// The turns the colours choose among for a colourful object (ColourOnlyParams::colour_turns),
+/// in the model's frame: the 23 turns of a cube (its axes permuted, signs that keep a rotation;
+/// not the identity), then the eighth turns (45, 135, 225 and 315 degrees) about x, y and z.
+std::vector<Eigen::Matrix3f> colourTurns();
+
 /// Each candidate (one a hypothesis, fitted and verified) whose outline passed, fitted again
 /// from its restarts (the finer rounds: 10, 5 and 3 px) and verified; the best scored of each
 /// is kept, the others that passed go to `result.rejected`; the refits count in
 /// `result.refined_candidates` and `refine_cpu_ms`. A turn fits the outline as well as
 /// the pose, so the colours and inner edges choose; a tilt lets the fit leave a start 15-30
-/// degrees off out of the image plane, where the outline fit turns little.
+/// degrees off out of the image plane, where the outline fit turns little. Colourful objects
+/// also start from the colour_turns best of colourTurns() after one screening round.
 void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                        const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
                        const DetectorParams& params, DetectionResult& result);

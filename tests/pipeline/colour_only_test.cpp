@@ -1,6 +1,7 @@
 // Colour-only detection (docs/pipeline.md, frames without depth): the directional chamfer fit of
 // stage 7 on a rendered scene, the 2D projection metric, and the detector on the real LM-O frame
 // with its depth withheld.
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -230,12 +231,43 @@ TEST(ColourOnly, AQuarterTurnThatFitsTheOutlineIsFittedAgainAndTheColoursChooseT
   EXPECT_TRUE(d.verified) << d.rejection;
   EXPECT_GT(d.colour_agreement, 0.8f);
   EXPECT_LT(proj2dError(s.mesh.vertices, d.pose.R, d.pose.t, s.truth.R, s.truth.t, s.camera), 1.5f);
-  // Without the turns it stays where it was.
+  // Without the look-alike turns the colour turns find it (the cube's quarter turn about z is
+  // one of them, screened best) ...
   params.colour_only.try_turns = false;
+  std::vector<PoseCandidate> screened{c};
+  fitAndVerifyByContour(screened, {object}, s.camera, s.bgr, maps, params);
+  refitFromRestarts(screened, {object}, s.camera, s.bgr, maps, params, result);
+  ASSERT_EQ(screened.size(), 1u);
+  EXPECT_TRUE(screened[0].detection.verified) << screened[0].detection.rejection;
+  EXPECT_LT(proj2dError(s.mesh.vertices, screened[0].detection.pose.R, screened[0].detection.pose.t, s.truth.R,
+                        s.truth.t, s.camera),
+            1.5f);
+  // ... and without either it stays where it was.
+  params.colour_only.colour_turns = 0;
   std::vector<PoseCandidate> alone{c};
   fitAndVerifyByContour(alone, {object}, s.camera, s.bgr, maps, params);
   refitFromRestarts(alone, {object}, s.camera, s.bgr, maps, params, result);
   EXPECT_FALSE(alone[0].detection.verified);
+}
+
+TEST(ColourOnly, TheColourTurnsAreTheCubesTurnsAndEighthTurnsEachOnce) {
+  const std::vector<Eigen::Matrix3f> turns = colourTurns();
+  ASSERT_EQ(turns.size(), 35u);  // 24 - 1 + 3 x 4
+  for (std::size_t a = 0; a < turns.size(); ++a) {
+    EXPECT_LT((turns[a] * turns[a].transpose() - Eigen::Matrix3f::Identity()).norm(), 1e-5f);
+    EXPECT_NEAR(turns[a].determinant(), 1.f, 1e-5f);
+    EXPECT_GT((turns[a] - Eigen::Matrix3f::Identity()).norm(), 0.5f);
+    for (std::size_t b = 0; b < a; ++b) EXPECT_GT((turns[a] - turns[b]).norm(), 0.5f) << a << " " << b;
+  }
+  const auto has = [&](float deg, const Eigen::Vector3f& axis) {
+    const Eigen::Matrix3f Q = Eigen::AngleAxisf(deg * static_cast<float>(M_PI / 180.0), axis).toRotationMatrix();
+    return std::any_of(turns.begin(), turns.end(), [&](const Eigen::Matrix3f& t) { return (t - Q).norm() < 1e-4f; });
+  };
+  EXPECT_TRUE(has(180.f, Eigen::Vector3f::UnitX()));   // upside down
+  EXPECT_TRUE(has(90.f, Eigen::Vector3f::UnitZ()));    // a quarter about the axis
+  EXPECT_TRUE(has(120.f, Eigen::Vector3f(1, 1, 1).normalized()));  // corner to corner
+  EXPECT_TRUE(has(45.f, Eigen::Vector3f::UnitY()));
+  EXPECT_TRUE(has(315.f, Eigen::Vector3f::UnitZ()));
 }
 
 }  // namespace
