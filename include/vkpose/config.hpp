@@ -470,7 +470,8 @@ struct ColourOnlyParams {
   /// outline cannot tell a painted box upside down or a cup turned about its axis from the
   /// truth, the colours can: on the table sets looked at, fits from the true pose scored
   /// 0.6-0.94 where the kept poses, 90-180 degrees off, scored 0.2-0.5. Tables 91 / 92 / 96:
-  /// F1 0.60 / 0.54 / 0.68 -> 0.66 / 0.61 / 0.78, for 1.3-1.4x the time of a frame.
+  /// F1 0.60 / 0.54 / 0.68 -> 0.66 / 0.61 / 0.78; held out (97-100) 0.66 -> 0.68 on average.
+  /// A frame takes 1.1-1.7x as long (docs/colour_only.md).
   int colour_turns = 3;
 };
 
