@@ -227,6 +227,29 @@ std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object,
   return out;
 }
 
+namespace {
+
+/// Whether a fitted candidate is worth restarting: it scored and its outline passed.
+bool outlinePassed(const Detection& d, const ColourOnlyParams& cp) {
+  return d.score > 0.f && !(d.contour_edges < cp.min_contour_support);
+}
+
+/// `c` to be fitted again from `start`: its verdict and CPU time cleared.
+PoseCandidate restartAt(PoseCandidate c, const Pose& start) {
+  c.start = start;
+  c.detection.rejection.clear();
+  c.detection.verified = false;
+  c.cpu_ms = 0;
+  return c;
+}
+
+/// The fits of `candidates` counted in the result (refined_candidates, refine_cpu_ms).
+void countFits(const std::vector<PoseCandidate>& candidates, DetectionResult& result) {
+  for (const PoseCandidate& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
+}
+
+}  // namespace
+
 std::vector<Eigen::Matrix3f> colourTurns() {
   std::vector<Eigen::Matrix3f> turns;
   // The turns of a cube: the axes permuted, with the signs that keep the determinant +1.
@@ -261,16 +284,10 @@ static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, co
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Detection& d = candidates[i].detection;
     const PoseObject& object = objects[candidates[i].bank()];
-    if (!(d.score > 0.f) || d.contour_edges < cp.min_contour_support || !object.colourful || object.bank->symmetric)
-      continue;
+    if (!outlinePassed(d, cp) || !object.colourful || object.bank->symmetric) continue;
     const Eigen::Vector3f centre = object.bank->centre;
     for (const Eigen::Matrix3f& Q : turns) {
-      PoseCandidate c = candidates[i];
-      c.start = compose(d.pose, Pose{Q, centre - Q * centre});
-      c.detection.rejection.clear();
-      c.detection.verified = false;
-      c.cpu_ms = 0;
-      screened.push_back(std::move(c));
+      screened.push_back(restartAt(candidates[i], compose(d.pose, Pose{Q, centre - Q * centre})));
       screened_of.push_back(i);
     }
   }
@@ -278,11 +295,9 @@ static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, co
   ContourFitParams one_round;
   one_round.truncation_px = {10.f};
   fitAndVerifyByContour(screened, objects, camera, bgr, maps, params, one_round);
+  countFits(screened, result);
   std::vector<std::vector<std::size_t>> of_candidate(candidates.size());
-  for (std::size_t k = 0; k < screened.size(); ++k) {
-    ++result.refined_candidates, result.refine_cpu_ms += screened[k].cpu_ms;
-    of_candidate[screened_of[k]].push_back(k);
-  }
+  for (std::size_t k = 0; k < screened.size(); ++k) of_candidate[screened_of[k]].push_back(k);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     std::vector<std::size_t>& ks = of_candidate[i];
     std::stable_sort(ks.begin(), ks.end(), [&](std::size_t a, std::size_t b) {
@@ -291,11 +306,8 @@ static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, co
     for (std::size_t r = 0; r < std::min(ks.size(), static_cast<std::size_t>(cp.colour_turns)); ++r) {
       PoseCandidate& c = screened[ks[r]];
       if (!(c.detection.score > 0.f)) break;
-      c.start = c.detection.pose;  // on from where the screening round left it
-      c.detection.rejection.clear();
-      c.detection.verified = false;
-      c.cpu_ms = 0;
-      again.push_back(std::move(c));
+      const Pose reached = c.detection.pose;  // on from where the screening round left it
+      again.push_back(restartAt(std::move(c), reached));
       of.push_back(i);
     }
   }
@@ -310,14 +322,9 @@ void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector
   std::iota(of.begin(), of.end(), std::size_t{0});
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Detection& d = candidates[i].detection;
-    if (!(d.score > 0.f) || d.contour_edges < cp.min_contour_support) continue;
+    if (!outlinePassed(d, cp)) continue;
     for (const Pose& start : colourOnlyRestarts(d.pose, objects[candidates[i].bank()], cp)) {
-      PoseCandidate c = candidates[i];
-      c.start = start;
-      c.detection.rejection.clear();
-      c.detection.verified = false;
-      c.cpu_ms = 0;
-      again.push_back(std::move(c));
+      again.push_back(restartAt(candidates[i], start));
       of.push_back(i);
     }
   }
@@ -326,7 +333,7 @@ void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector
   ContourFitParams finer;
   finer.truncation_px = {10.f, 5.f, 3.f};
   fitAndVerifyByContour(again, objects, camera, bgr, maps, params, finer);
-  for (const auto& c : again) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
+  countFits(again, result);
   std::move(again.begin(), again.end(), std::back_inserter(candidates));
   keepBestStart(candidates, of, result);
 }
@@ -431,7 +438,7 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   const EdgeDistanceMaps maps = edgeDistanceMaps(frame.bgr, params_.colour_only.canny_low, params_.colour_only.canny_high);
   clock.end(Stage::edges, result);
   fitAndVerifyByContour(candidates, objects_, camera, frame.bgr, maps, params_);
-  for (const auto& c : candidates) ++result.refined_candidates, result.refine_cpu_ms += c.cpu_ms;
+  countFits(candidates, result);
   keepBestStart(candidates, hypothesis_of, result);
   refitFromRestarts(candidates, objects_, camera, frame.bgr, maps, params_, result);
   clock.end(Stage::contour_fit, result);
