@@ -473,6 +473,13 @@ struct ColourOnlyParams {
   /// F1 0.60 / 0.54 / 0.68 -> 0.66 / 0.61 / 0.78; held out (97-100) 0.66 -> 0.68 on average.
   /// A frame takes 1.1-1.7x as long (docs/colour_only.md).
   int colour_turns = 3;
+  /// Rounds of these restarts. After the first, each pose that a restart improved is fitted
+  /// again from its own look-alike turns and tilts (not the colour turns), until none improves
+  /// or this many rounds are done (1: one round). A colour turn that found the right face
+  /// leaves the pose tilted; the next round's tilt squares it up. Table sets looked at (91 /
+  /// 92 / 95 / 96): F1 0.66 / 0.61 / 0.85 / 0.78 -> 0.78 / 0.67 / 0.85 / 0.88 (history.md,
+  /// 2026-12-07 afternoon).
+  int restart_rounds = 3;
 };
 
 struct DetectorParams {

@@ -178,8 +178,9 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
 
 /// Of each hypothesis's starts the best scored; the others that had passed go to the rejected
 /// (those that had not are dropped: their hypothesis is represented by the best).
-static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vector<std::size_t>& hypothesis_of,
-                          DetectionResult& result) {
+static std::vector<char> keepBestStart(std::vector<PoseCandidate>& candidates,
+                                       const std::vector<std::size_t>& hypothesis_of, DetectionResult& result,
+                                       std::size_t first_restart) {
   std::vector<int> best(candidates.size(), -1);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     int& b = best[hypothesis_of[i]];
@@ -187,9 +188,11 @@ static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vec
       b = static_cast<int>(i);
   }
   std::vector<PoseCandidate> kept;
+  std::vector<char> restarted;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     if (best[hypothesis_of[i]] == static_cast<int>(i)) {
       kept.push_back(std::move(candidates[i]));
+      restarted.push_back(i >= first_restart ? 1 : 0);
     } else if (candidates[i].detection.verified) {
       candidates[i].detection.verified = false;
       candidates[i].detection.rejection = "another rotation start of its hypothesis fit better";
@@ -197,6 +200,7 @@ static void keepBestStart(std::vector<PoseCandidate>& candidates, const std::vec
     }
   }
   candidates = std::move(kept);
+  return restarted;
 }
 
 /// The turns of a pose that its templates cannot tell from it: the bank's near-symmetries where
@@ -313,29 +317,45 @@ static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, co
   }
 }
 
-void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
-                       const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
-                       const DetectorParams& params, DetectionResult& result) {
+/// One round of refitFromRestarts. `improved`: null in the first round (every candidate whose
+/// outline passed, the colour turns too); then which candidates a restart improved in the
+/// round before (their look-alike turns and tilts only). Returns, per candidate kept, whether
+/// a restart won.
+static std::vector<char> restartRound(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                                      const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                                      const DetectorParams& params, DetectionResult& result,
+                                      const std::vector<char>* improved) {
   const ColourOnlyParams& cp = params.colour_only;
   std::vector<PoseCandidate> again;
   std::vector<std::size_t> of(candidates.size());
   std::iota(of.begin(), of.end(), std::size_t{0});
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Detection& d = candidates[i].detection;
-    if (!outlinePassed(d, cp)) continue;
+    if (!outlinePassed(d, cp) || (improved && !(*improved)[i])) continue;
     for (const Pose& start : colourOnlyRestarts(d.pose, objects[candidates[i].bank()], cp)) {
       again.push_back(restartAt(candidates[i], start));
       of.push_back(i);
     }
   }
-  addColourTurnStarts(candidates, objects, camera, bgr, maps, params, result, again, of);
-  if (again.empty()) return;
+  if (!improved) addColourTurnStarts(candidates, objects, camera, bgr, maps, params, result, again, of);
+  if (again.empty()) return std::vector<char>(candidates.size(), 0);
   ContourFitParams finer;
   finer.truncation_px = {10.f, 5.f, 3.f};
   fitAndVerifyByContour(again, objects, camera, bgr, maps, params, finer);
   countFits(again, result);
+  const std::size_t first_restart = candidates.size();
   std::move(again.begin(), again.end(), std::back_inserter(candidates));
-  keepBestStart(candidates, of, result);
+  return keepBestStart(candidates, of, result, first_restart);
+}
+
+void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
+                       const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
+                       const DetectorParams& params, DetectionResult& result) {
+  std::vector<char> improved = restartRound(candidates, objects, camera, bgr, maps, params, result, nullptr);
+  for (int round = 1; round < params.colour_only.restart_rounds; ++round) {
+    if (std::find(improved.begin(), improved.end(), 1) == improved.end()) break;
+    improved = restartRound(candidates, objects, camera, bgr, maps, params, result, &improved);
+  }
 }
 
 /// The accepted candidates, best score first, each unless a better one's centre projects
@@ -439,7 +459,7 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   clock.end(Stage::edges, result);
   fitAndVerifyByContour(candidates, objects_, camera, frame.bgr, maps, params_);
   countFits(candidates, result);
-  keepBestStart(candidates, hypothesis_of, result);
+  keepBestStart(candidates, hypothesis_of, result, candidates.size());
   refitFromRestarts(candidates, objects_, camera, frame.bgr, maps, params_, result);
   clock.end(Stage::contour_fit, result);
   acceptByContour(candidates, banks_, camera, result);

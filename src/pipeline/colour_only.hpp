@@ -52,7 +52,10 @@ std::vector<Eigen::Matrix3f> colourTurns();
 /// `result.refined_candidates` and `refine_cpu_ms`. A turn fits the outline as well as
 /// the pose, so the colours and inner edges choose; a tilt lets the fit leave a start 15-30
 /// degrees off out of the image plane, where the outline fit turns little. Colourful objects
-/// also start from the colour_turns best of colourTurns() after one screening round.
+/// also start from the colour_turns best of colourTurns() after one screening round. Up to
+/// ColourOnlyParams::restart_rounds rounds: after the first, the poses a restart improved
+/// start again from their own look-alike turns and tilts (a colour turn that found the right
+/// face, then a tilt that squares it up).
 void refitFromRestarts(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                        const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
                        const DetectorParams& params, DetectionResult& result);

@@ -158,6 +158,20 @@ struct PaintedBoxScene {
   }
 };
 
+/// The painted box as the detector sees it (rendered by `renderer`) and the frame it is seen in:
+/// the box at the truth on grey.
+PoseObject paintedBoxSeen(PaintedBoxScene& s, MeshRenderer& renderer) {
+  PoseObject object;
+  object.bank = &s.bank;
+  object.renderer = &renderer;
+  object.bounding_radius = 0.5f * s.mesh.diameter;
+  object.colourful = true;
+  const Rendering seen = renderer.render(s.camera, {s.truth}).front();
+  s.bgr = cv::Mat(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
+  seen.bgr.copyTo(s.bgr, seen.mask());
+  return object;
+}
+
 TEST(ColourOnly, RestartsAreTheLookAlikeTurnsThenTiltsAboutTheCentre) {
   PaintedBoxScene s;
   ASSERT_GE(s.bank.near_symmetries.size(), 3u);  // 90, 180 and 270 degrees about z
@@ -195,14 +209,7 @@ TEST(ColourOnly, RestartsAreTheLookAlikeTurnsThenTiltsAboutTheCentre) {
 TEST(ColourOnly, AQuarterTurnThatFitsTheOutlineIsFittedAgainAndTheColoursChooseTheTruth) {
   PaintedBoxScene s;
   MeshRenderer renderer(test::context(), s.mesh);
-  PoseObject object;
-  object.bank = &s.bank;
-  object.renderer = &renderer;
-  object.bounding_radius = 0.5f * s.mesh.diameter;
-  object.colourful = true;
-  const Rendering seen = renderer.render(s.camera, {s.truth}).front();
-  s.bgr = cv::Mat(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
-  seen.bgr.copyTo(s.bgr, seen.mask());
+  const PoseObject object = paintedBoxSeen(s, renderer);
   const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
 
   // Stage 6 started it a quarter-turn about the box's axis off: the outline is the same.
@@ -248,6 +255,48 @@ TEST(ColourOnly, AQuarterTurnThatFitsTheOutlineIsFittedAgainAndTheColoursChooseT
   fitAndVerifyByContour(alone, {object}, s.camera, s.bgr, maps, params);
   refitFromRestarts(alone, {object}, s.camera, s.bgr, maps, params, result);
   EXPECT_FALSE(alone[0].detection.verified);
+}
+
+TEST(ColourOnly, APoseARestartImprovedIsRestartedAgainFromWhereItWon) {
+  PaintedBoxScene s;
+  MeshRenderer renderer(test::context(), s.mesh);
+  const PoseObject object = paintedBoxSeen(s, renderer);
+  const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
+  const auto fitted = [&](const Pose& start, int rounds, std::size_t& fits) {
+    PoseCandidate c;
+    c.detection.bank = 0;
+    c.detection.object = s.bank.object;
+    c.start = start;
+    const Eigen::Vector2f at = s.camera.project(s.truth.t);
+    c.detection.x = at.x(), c.detection.y = at.y();
+    DetectorParams params;
+    params.colour_only.colour_turns = 0;
+    params.colour_only.restart_rounds = rounds;
+    std::vector<PoseCandidate> candidates{c};
+    fitAndVerifyByContour(candidates, {object}, s.camera, s.bgr, maps, params);
+    DetectionResult result;
+    refitFromRestarts(candidates, {object}, s.camera, s.bgr, maps, params, result);
+    fits = result.refined_candidates;
+    return candidates.at(0).detection;
+  };
+  // Turned a quarter about the box's axis and tilted 29 degrees out of the image plane: after
+  // one round of restarts the pose is still tens of pixels off (a restart improved it) ...
+  const auto quarter = std::find_if(s.bank.near_symmetries.begin(), s.bank.near_symmetries.end(),
+                                    [](const NearSymmetry& n) { return std::abs(n.angle_deg - 90.f) < 1.f; });
+  ASSERT_NE(quarter, s.bank.near_symmetries.end());
+  const Eigen::Matrix3f tilt = Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitX()).toRotationMatrix();
+  const Pose turned = compose(s.truth, quarter->transform());
+  const Pose start{tilt * turned.R, tilt * (turned.t - s.truth.t) + s.truth.t};
+  std::size_t one_round = 0, rounds = 0;
+  const Detection once = fitted(start, 1, one_round);
+  const Detection more = fitted(start, 3, rounds);
+  EXPECT_EQ(one_round, colourOnlyRestarts(start, object, DetectorParams{}.colour_only).size());
+  EXPECT_GT(proj2dError(s.mesh.vertices, once.pose.R, once.pose.t, s.truth.R, s.truth.t, s.camera), 10.f);
+  // ... restarted again from where that restart left it, it reaches the truth.
+  EXPECT_GT(rounds, one_round);
+  EXPECT_TRUE(more.verified) << more.rejection;
+  EXPECT_LT(proj2dError(s.mesh.vertices, more.pose.R, more.pose.t, s.truth.R, s.truth.t, s.camera), 1.5f);
+  EXPECT_GT(more.score, once.score);
 }
 
 TEST(ColourOnly, TheColourTurnsAreTheCubesTurnsAndEighthTurnsEachOnce) {
