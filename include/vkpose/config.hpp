@@ -477,8 +477,8 @@ struct ColourOnlyParams {
   /// again from its own look-alike turns and tilts (not the colour turns), until none improves
   /// or this many rounds are done (1: one round). A colour turn that found the right face
   /// leaves the pose tilted; the next round's tilt squares it up. Table sets looked at (91 /
-  /// 92 / 95 / 96): F1 0.66 / 0.61 / 0.85 / 0.78 -> 0.78 / 0.67 / 0.85 / 0.88 (history.md,
-  /// 2026-12-07 afternoon).
+  /// 92 / 95 / 96): F1 0.66 / 0.61 / 0.85 / 0.78 -> 0.78 / 0.67 / 0.85 / 0.88; held out (97-102)
+  /// 0.72 -> 0.74 on average, bins 0.39 -> 0.42 (history.md, 2026-12-07 afternoon).
   int restart_rounds = 3;
 };
 

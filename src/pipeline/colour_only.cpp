@@ -177,7 +177,8 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
 }
 
 /// Of each hypothesis's starts the best scored; the others that had passed go to the rejected
-/// (those that had not are dropped: their hypothesis is represented by the best).
+/// (those that had not are dropped: their hypothesis is represented by the best). Returns, per
+/// candidate kept, whether it was one of those from `first_restart` on (a restart that won).
 static std::vector<char> keepBestStart(std::vector<PoseCandidate>& candidates,
                                        const std::vector<std::size_t>& hypothesis_of, DetectionResult& result,
                                        std::size_t first_restart) {
