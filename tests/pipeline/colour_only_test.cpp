@@ -156,6 +156,22 @@ struct PaintedBoxScene {
                   .toRotationMatrix();
     truth.t = {0.02f, -0.01f, 0.6f};
   }
+  /// The bank's near-symmetry a quarter turn about the box's axis (null if it found none).
+  const NearSymmetry* quarterTurn() const {
+    const auto q = std::find_if(bank.near_symmetries.begin(), bank.near_symmetries.end(),
+                                [](const NearSymmetry& n) { return std::abs(n.angle_deg - 90.f) < 1.f; });
+    return q == bank.near_symmetries.end() ? nullptr : &*q;
+  }
+  /// A hypothesis at the box's place, stage 6 having started it at `start`.
+  PoseCandidate candidateFrom(const Pose& start) const {
+    PoseCandidate c;
+    c.detection.bank = 0;
+    c.detection.object = bank.object;
+    c.start = start;
+    const Eigen::Vector2f at = camera.project(truth.t);
+    c.detection.x = at.x(), c.detection.y = at.y();
+    return c;
+  }
 };
 
 /// The painted box as the detector sees it (rendered by `renderer`) and the frame it is seen in:
@@ -213,15 +229,9 @@ TEST(ColourOnly, AQuarterTurnThatFitsTheOutlineIsFittedAgainAndTheColoursChooseT
   const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
 
   // Stage 6 started it a quarter-turn about the box's axis off: the outline is the same.
-  const auto quarter = std::find_if(s.bank.near_symmetries.begin(), s.bank.near_symmetries.end(),
-                                    [](const NearSymmetry& n) { return std::abs(n.angle_deg - 90.f) < 1.f; });
-  ASSERT_NE(quarter, s.bank.near_symmetries.end());
-  PoseCandidate c;
-  c.detection.bank = 0;
-  c.detection.object = s.bank.object;
-  c.start = compose(s.truth, quarter->transform());
-  const Eigen::Vector2f at = s.camera.project(s.truth.t);
-  c.detection.x = at.x(), c.detection.y = at.y();
+  const NearSymmetry* quarter = s.quarterTurn();
+  ASSERT_NE(quarter, nullptr);
+  const PoseCandidate c = s.candidateFrom(compose(s.truth, quarter->transform()));
   DetectorParams params;
   params.colour_only.tilt_restart_deg = 0.f;
   std::vector<PoseCandidate> candidates{c};
@@ -263,16 +273,10 @@ TEST(ColourOnly, APoseARestartImprovedIsRestartedAgainFromWhereItWon) {
   const PoseObject object = paintedBoxSeen(s, renderer);
   const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
   const auto fitted = [&](const Pose& start, int rounds, std::size_t& fits) {
-    PoseCandidate c;
-    c.detection.bank = 0;
-    c.detection.object = s.bank.object;
-    c.start = start;
-    const Eigen::Vector2f at = s.camera.project(s.truth.t);
-    c.detection.x = at.x(), c.detection.y = at.y();
     DetectorParams params;
     params.colour_only.colour_turns = 0;
     params.colour_only.restart_rounds = rounds;
-    std::vector<PoseCandidate> candidates{c};
+    std::vector<PoseCandidate> candidates{s.candidateFrom(start)};
     fitAndVerifyByContour(candidates, {object}, s.camera, s.bgr, maps, params);
     DetectionResult result;
     refitFromRestarts(candidates, {object}, s.camera, s.bgr, maps, params, result);
@@ -281,9 +285,8 @@ TEST(ColourOnly, APoseARestartImprovedIsRestartedAgainFromWhereItWon) {
   };
   // Turned a quarter about the box's axis and tilted 29 degrees out of the image plane: after
   // one round of restarts the pose is still tens of pixels off (a restart improved it) ...
-  const auto quarter = std::find_if(s.bank.near_symmetries.begin(), s.bank.near_symmetries.end(),
-                                    [](const NearSymmetry& n) { return std::abs(n.angle_deg - 90.f) < 1.f; });
-  ASSERT_NE(quarter, s.bank.near_symmetries.end());
+  const NearSymmetry* quarter = s.quarterTurn();
+  ASSERT_NE(quarter, nullptr);
   const Eigen::Matrix3f tilt = Eigen::AngleAxisf(0.5f, Eigen::Vector3f::UnitX()).toRotationMatrix();
   const Pose turned = compose(s.truth, quarter->transform());
   const Pose start{tilt * turned.R, tilt * (turned.t - s.truth.t) + s.truth.t};
