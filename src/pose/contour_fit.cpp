@@ -75,9 +75,9 @@ struct EdgePixel {
   uint8_t bin;
 };
 
-/// The model's edges in a rendering: the mask's border and inner depth steps, then the edges of
-/// the rendered colours inside (see contourPoints).
-std::vector<EdgePixel> modelEdgePixels(const Rendering& rendering, float inner_step_m) {
+/// The model's edges in a rendering: the mask's border and inner depth steps, then (with
+/// `colour_edges`) the edges of the rendered colours inside (see contourPoints).
+std::vector<EdgePixel> modelEdgePixels(const Rendering& rendering, float inner_step_m, bool colour_edges = true) {
   const cv::Mat& z = rendering.depth;
   std::vector<EdgePixel> found;
   const auto at = [&](int x, int y) {
@@ -116,7 +116,8 @@ std::vector<EdgePixel> modelEdgePixels(const Rendering& rendering, float inner_s
   // The edges of the model's own colours inside the outline (painted or scanned texture): what
   // tells a view from its silhouette's look-alikes. Two pixels in from the outline, so the
   // border's own gradient is not counted twice.
-  if (rendering.bgr.type() == CV_8UC3 && rendering.bgr.size() == z.size() && z.cols >= 8 && z.rows >= 8) {
+  if (colour_edges && rendering.bgr.type() == CV_8UC3 && rendering.bgr.size() == z.size() && z.cols >= 8 &&
+      z.rows >= 8) {
     const EdgeDistanceMaps own = edgeDistanceMaps(rendering.bgr, 40, 100, false);
     cv::Mat inside = z > 0.f, eroded;
     cv::erode(inside, eroded, cv::Mat(), {-1, -1}, 2);
@@ -138,10 +139,11 @@ void checkRendering(const Rendering& rendering, const cv::Rect& window) {
 }  // namespace
 
 std::vector<ContourPoint> contourPoints(const Rendering& rendering, const Pose& pose, const Camera& camera,
-                                        const cv::Rect& window, int max_points, float inner_step_m) {
+                                        const cv::Rect& window, int max_points, float inner_step_m,
+                                        bool colour_edges) {
   checkRendering(rendering, window);
   const cv::Mat& z = rendering.depth;
-  const std::vector<EdgePixel> found = modelEdgePixels(rendering, inner_step_m);
+  const std::vector<EdgePixel> found = modelEdgePixels(rendering, inner_step_m, colour_edges);
   std::vector<ContourPoint> points;
   if (found.empty()) return points;
   const std::size_t step = std::max<std::size_t>(1, (found.size() + static_cast<std::size_t>(max_points) - 1) /

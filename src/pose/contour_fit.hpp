@@ -52,10 +52,13 @@ struct ContourPoint {
 
 /// The outline of a rendering of `pose` that covers `window` of `camera`'s image
 /// (windowCamera): the mask's border, the inner depth steps of more than `inner_step_m` (the
-/// nearer side) and the edges of the rendered colours inside, evenly thinned to at most
-/// `max_points`.
+/// nearer side) and, with `colour_edges`, the edges of the rendered colours inside, evenly
+/// thinned to at most `max_points`. A mesh without colours renders shaded by a light at the
+/// camera: its inner edges (a scanned part's ridges) are where that light puts them, not the
+/// frame's light.
 std::vector<ContourPoint> contourPoints(const Rendering& rendering, const Pose& pose, const Camera& camera,
-                                        const cv::Rect& window, int max_points = 400, float inner_step_m = 0.01f);
+                                        const cv::Rect& window, int max_points = 400, float inner_step_m = 0.01f,
+                                        bool colour_edges = true);
 
 struct ContourFitParams {
   /// Truncation of the distances per round, pixels, coarse to fine: a point farther from

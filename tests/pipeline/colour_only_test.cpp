@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -92,6 +94,38 @@ TEST(ContourFit, SupportIsHighOnTheObjectAndLowBesideIt) {
   Pose beside = s.truth;
   beside.t.x() += 0.012f;  // about 11 px
   EXPECT_LT(chamferSupport(points, beside, s.camera, maps), 0.4f);
+}
+
+TEST(ContourFit, WithoutColourEdgesTheShadedInsideIsLeftOut) {
+  // The L-shape has no colours: its rendering is shaded, and the shading changes across its
+  // folds inside the outline. Without colour edges those inner points go; the outline and the
+  // depth steps stay, point for point.
+  const Scene s = renderedScene();
+  float radius = 0.f;
+  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
+  const cv::Rect window = projectedWindow(s.truth, Eigen::Vector3f::Zero(), radius, s.camera);
+  const Rendering r = renderReference(s.mesh, windowCamera(s.camera, window), s.truth);
+  constexpr int kAll = 1 << 20;  // no thinning: the two sets can be compared point for point
+  const auto with = contourPoints(r, s.truth, s.camera, window, kAll, 0.01f, true);
+  const auto without = contourPoints(r, s.truth, s.camera, window, kAll, 0.01f, false);
+  const auto key = [](const ContourPoint& p) { return std::tuple(p.model.x(), p.model.y(), p.model.z(), p.bin); };
+  std::set<std::tuple<float, float, float, uint8_t>> kept;
+  for (const ContourPoint& p : with) kept.insert(key(p));
+  ASSERT_GT(without.size(), 50u);
+  for (const ContourPoint& p : without) EXPECT_TRUE(kept.count(key(p))) << "a point that colour edges do not add";
+  EXPECT_GT(with.size(), without.size() + 20) << "the shaded L-shape shows no edge inside its outline";
+  // What went is inside: two pixels or more in from the mask's border.
+  cv::Mat inner;
+  cv::erode(r.mask(), inner, cv::Mat(), {-1, -1}, 2);
+  std::set<std::tuple<float, float, float, uint8_t>> outline;
+  for (const ContourPoint& p : without) outline.insert(key(p));
+  for (const ContourPoint& p : with) {
+    if (outline.count(key(p))) continue;
+    const Eigen::Vector2f uv = s.camera.project(s.truth.R * p.model + s.truth.t);
+    const int x = static_cast<int>(std::lround(uv.x())) - window.x, y = static_cast<int>(std::lround(uv.y())) - window.y;
+    ASSERT_TRUE(x >= 0 && y >= 0 && x < inner.cols && y < inner.rows);
+    EXPECT_TRUE(inner.at<uint8_t>(y, x)) << "a colour edge point on the outline at " << x << "," << y;
+  }
 }
 
 TEST(Proj2d, IsZeroForThePoseItselfAndTheShiftInPixels) {
