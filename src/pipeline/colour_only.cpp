@@ -128,7 +128,7 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
             return;
           }
           // A mesh without colours is fitted by its outline alone: the edges of its shading
-          // pulled fits started at the truth 5-28 degrees off (the milk jug on the synthetic
+          // pulled fits started at the truth 4-28 degrees off (the milk jug on the synthetic
           // tables). Verification below keeps them: without them a box-like outline passes on
           // any box.
           const bool own_colours = !objects[candidates[i].bank()].bank->mesh.colours.empty();
