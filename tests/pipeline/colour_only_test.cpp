@@ -108,8 +108,9 @@ TEST(ContourFit, WithoutColourEdgesTheShadedInsideIsLeftOut) {
   constexpr int kAll = 1 << 20;  // no thinning: the two sets can be compared point for point
   const auto with = contourPoints(r, s.truth, s.camera, window, kAll, 0.01f, true);
   const auto without = contourPoints(r, s.truth, s.camera, window, kAll, 0.01f, false);
-  const auto key = [](const ContourPoint& p) { return std::tuple(p.model.x(), p.model.y(), p.model.z(), p.bin); };
-  std::set<std::tuple<float, float, float, uint8_t>> kept;
+  using PointKey = std::tuple<float, float, float, uint8_t>;
+  const auto key = [](const ContourPoint& p) { return PointKey(p.model.x(), p.model.y(), p.model.z(), p.bin); };
+  std::set<PointKey> kept;
   for (const ContourPoint& p : with) kept.insert(key(p));
   ASSERT_GT(without.size(), 50u);
   for (const ContourPoint& p : without) EXPECT_TRUE(kept.count(key(p))) << "a point that colour edges do not add";
@@ -117,7 +118,7 @@ TEST(ContourFit, WithoutColourEdgesTheShadedInsideIsLeftOut) {
   // What went is inside: two pixels or more in from the mask's border.
   cv::Mat inner;
   cv::erode(r.mask(), inner, cv::Mat(), {-1, -1}, 2);
-  std::set<std::tuple<float, float, float, uint8_t>> outline;
+  std::set<PointKey> outline;
   for (const ContourPoint& p : without) outline.insert(key(p));
   for (const ContourPoint& p : with) {
     if (outline.count(key(p))) continue;
