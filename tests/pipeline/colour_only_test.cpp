@@ -37,6 +37,13 @@ struct Scene {
   Camera camera;
   Pose truth;
   cv::Mat bgr;
+
+  /// The image window the L-shape at `pose` covers (its farthest vertex from the origin).
+  cv::Rect windowAt(const Pose& pose) const {
+    float radius = 0.f;
+    for (const auto& v : mesh.vertices) radius = std::max(radius, v.norm());
+    return projectedWindow(pose, Eigen::Vector3f::Zero(), radius, camera);
+  }
 };
 
 /// The L-shape rendered (the reference rasterizer, shaded grey) on an orange background (a
@@ -59,10 +66,8 @@ float proj2d(const Scene& s, const Pose& p) {
 
 /// Rounds of render, outline and fit from `start`, as the detector runs them.
 Pose fitFrom(const Scene& s, const EdgeDistanceMaps& maps, Pose pose) {
-  float radius = 0.f;
-  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
   for (const float truncation : ContourFitParams{}.truncation_px) {
-    const cv::Rect window = projectedWindow(pose, Eigen::Vector3f::Zero(), radius, s.camera);
+    const cv::Rect window = s.windowAt(pose);
     const Rendering r = renderReference(s.mesh, windowCamera(s.camera, window), pose);
     const auto points = contourPoints(r, pose, s.camera, window);
     EXPECT_GT(points.size(), 50u);
@@ -85,9 +90,7 @@ TEST(ContourFit, PullsAShiftedAndTurnedPoseBackOntoTheEdges) {
 TEST(ContourFit, SupportIsHighOnTheObjectAndLowBesideIt) {
   const Scene s = renderedScene();
   const EdgeDistanceMaps maps = edgeDistanceMaps(s.bgr);
-  float radius = 0.f;
-  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
-  const cv::Rect window = projectedWindow(s.truth, Eigen::Vector3f::Zero(), radius, s.camera);
+  const cv::Rect window = s.windowAt(s.truth);
   const auto points =
       contourPoints(renderReference(s.mesh, windowCamera(s.camera, window), s.truth), s.truth, s.camera, window);
   EXPECT_GT(chamferSupport(points, s.truth, s.camera, maps), 0.9f);
@@ -101,9 +104,7 @@ TEST(ContourFit, WithoutColourEdgesTheShadedInsideIsLeftOut) {
   // folds inside the outline. Without colour edges those inner points go; the outline and the
   // depth steps stay, point for point.
   const Scene s = renderedScene();
-  float radius = 0.f;
-  for (const auto& v : s.mesh.vertices) radius = std::max(radius, v.norm());
-  const cv::Rect window = projectedWindow(s.truth, Eigen::Vector3f::Zero(), radius, s.camera);
+  const cv::Rect window = s.windowAt(s.truth);
   const Rendering r = renderReference(s.mesh, windowCamera(s.camera, window), s.truth);
   constexpr int kAll = 1 << 20;  // no thinning: the two sets can be compared point for point
   const auto with = contourPoints(r, s.truth, s.camera, window, kAll, 0.01f, true);
