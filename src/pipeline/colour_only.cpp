@@ -129,8 +129,8 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
           }
           // A mesh without colours is fitted by its outline alone: the edges of its shading
           // pulled fits started at the truth 4-28 degrees off (the milk jug on the synthetic
-          // tables). Verification below keeps them: without them a box-like outline passes on
-          // any box.
+          // tables). Verification below keeps them but over a surface of one colour: without
+          // them a box-like outline passes on any box.
           const bool own_colours = !objects[candidates[i].bank()].bank->mesh.colours.empty();
           const auto points = contourPoints(rendering, poses[i], camera, window, 400, 0.01f, own_colours);
           const ContourFit fit =
@@ -163,19 +163,32 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
           d.score = 0.f;
           return;
         }
+        const bool own_colours = !objects[c.bank()].bank->mesh.colours.empty();
         d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
+        float needed = cp.min_contour_support;  // of d.contour_edges
+        if (!own_colours && cp.min_plain_outline_support > 0.f) {
+          // Over a surface of one colour the outline alone verifies it, asking more of it: the
+          // frame's light need not put edges where the rendered shading has them.
+          const double spread = seenChromaSpread(rendering, window, bgr);
+          if (spread < kMinChromaSpread) {
+            const auto outline = contourPoints(rendering, poses[i], camera, window, 400, 0.01f, false);
+            d.contour_edges = chamferSupport(outline, poses[i], camera, maps, cp.edge_tolerance_px);
+            needed = cp.min_plain_outline_support;
+          }
+        }
+        c.outline_passed = !(d.contour_edges < needed);
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
-        const bool colour_counts = !objects[c.bank()].bank->mesh.colours.empty() && colour.colour_informative;
+        const bool colour_counts = own_colours && colour.colour_informative;
         d.colour_agreement = colour_counts ? colour.colour : 1.f;
         d.colour_measured = colour_counts;
         d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
         d.score = d.contour_edges * d.explained_edges * (colour_counts ? 0.5f * (1.f + colour.colour) : 1.f);
-        if (d.contour_edges < cp.min_contour_support)
+        if (!c.outline_passed)
           d.rejection = fmt::format("{:.0f} % of its outline meets an image edge, {:.0f} % needed",
-                                    100.f * d.contour_edges, 100.f * cp.min_contour_support);
-        else if (const float needed = objects[c.bank()].colourful ? cp.min_colourful_agreement : cp.min_colour_agreement;
-                 colour_counts && needed > -1.f && colour.colour < needed)
-          d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour, needed);
+                                    100.f * d.contour_edges, 100.f * needed);
+        else if (const float agreement = objects[c.bank()].colourful ? cp.min_colourful_agreement : cp.min_colour_agreement;
+                 colour_counts && agreement > -1.f && colour.colour < agreement)
+          d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour, agreement);
         d.verified = d.rejection.empty();
       },
       params.threads);
@@ -240,15 +253,14 @@ std::vector<Pose> colourOnlyRestarts(const Pose& pose, const PoseObject& object,
 namespace {
 
 /// Whether a fitted candidate is worth restarting: it scored and its outline passed.
-bool outlinePassed(const Detection& d, const ColourOnlyParams& cp) {
-  return d.score > 0.f && !(d.contour_edges < cp.min_contour_support);
-}
+bool outlinePassed(const PoseCandidate& c) { return c.detection.score > 0.f && c.outline_passed; }
 
 /// `c` to be fitted again from `start`: its verdict and CPU time cleared.
 PoseCandidate restartAt(PoseCandidate c, const Pose& start) {
   c.start = start;
   c.detection.rejection.clear();
   c.detection.verified = false;
+  c.outline_passed = false;
   c.cpu_ms = 0;
   return c;
 }
@@ -294,7 +306,7 @@ static void addColourTurnStarts(const std::vector<PoseCandidate>& candidates, co
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Detection& d = candidates[i].detection;
     const PoseObject& object = objects[candidates[i].bank()];
-    if (!outlinePassed(d, cp) || !object.colourful || object.bank->symmetric) continue;
+    if (!outlinePassed(candidates[i]) || !object.colourful || object.bank->symmetric) continue;
     const Eigen::Vector3f centre = object.bank->centre;
     for (const Eigen::Matrix3f& Q : turns) {
       screened.push_back(restartAt(candidates[i], compose(d.pose, Pose{Q, centre - Q * centre})));
@@ -337,7 +349,7 @@ static std::vector<char> restartRound(std::vector<PoseCandidate>& candidates, co
   std::iota(of.begin(), of.end(), std::size_t{0});
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Detection& d = candidates[i].detection;
-    if (!outlinePassed(d, cp) || (improved && !(*improved)[i])) continue;
+    if (!outlinePassed(candidates[i]) || (improved && !(*improved)[i])) continue;
     for (const Pose& start : colourOnlyRestarts(d.pose, objects[candidates[i].bank()], cp)) {
       again.push_back(restartAt(candidates[i], start));
       of.push_back(i);

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
 
 #include "vkpose/error.hpp"
 
@@ -35,6 +38,27 @@ double meshChromaSpread(const Mesh& mesh) {
     n += 1, sr += r, sg += g, ss += r * r + g * g;
   }
   if (n < 2) return 0.0;
+  return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
+}
+
+double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr) {
+  if (scene_bgr.type() != CV_8UC3) throw InputError("seenChromaSpread: the scene must be 8-bit BGR");
+  if (rendering.depth.size() != window.size()) throw InputError("seenChromaSpread: the rendering is not the window's size");
+  cv::Mat inside = rendering.depth > 0.f;
+  cv::erode(inside, inside, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+  double n = 0, sr = 0, sg = 0, ss = 0;
+  for (int y = 0; y < window.height; ++y) {
+    const int sy = y + window.y;
+    if (sy < 0 || sy >= scene_bgr.rows) continue;
+    for (int x = 0; x < window.width; ++x) {
+      const int sx = x + window.x;
+      double r, g;
+      if (sx < 0 || sx >= scene_bgr.cols || !inside.at<uint8_t>(y, x) || !chroma(scene_bgr.at<cv::Vec3b>(sy, sx), r, g))
+        continue;
+      n += 1, sr += r, sg += g, ss += r * r + g * g;
+    }
+  }
+  if (n < kMinColourPixels) return std::numeric_limits<double>::quiet_NaN();
   return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
 }
 

@@ -37,6 +37,12 @@ constexpr double kMinChromaSpread = 0.05;
 /// colour count for meshes of at least kMinChromaSpread.
 double meshChromaSpread(const Mesh& mesh);
 
+/// The spread (as kMinChromaSpread's) of the scene's chromaticity over the rendering's mask,
+/// 2 px in from its outline (a pose a pixel off would count its surroundings); NaN where fewer
+/// than 20 pixels are bright enough to have one. Under kMinChromaSpread the pose lies on a
+/// surface of one colour. `rendering` covers `window` of `scene_bgr` (CV_8UC3).
+double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr);
+
 /// `rendering` covers `window` of the scene (MeshRenderer::render through windowCamera).
 /// scene_bgr: CV_8UC3, scene_depth_m: CV_32FC1 (0 = none), both full frames of one size.
 /// Without `colour_counts` the score is the depth fit alone.

@@ -108,6 +108,9 @@ struct PoseCandidate {
   /// ICP brought it to the pose of a better candidate (markTwins): not compared or accepted.
   bool twin = false;
   double cpu_ms = 0;       ///< stages 7-8's CPU time for this candidate
+  /// Colour only: its outline met as many image edges as verification asks
+  /// (fitAndVerifyByContour); only those are fitted again from restarts.
+  bool outline_passed = false;
 
   std::size_t bank() const { return static_cast<std::size_t>(detection.bank); }
   /// Stage 6 placed it and the first fit did not stop it: MLS, ICP and stage 8 run on it (or

@@ -338,6 +338,67 @@ TEST(ColourOnly, APoseARestartImprovedIsRestartedAgainFromWhereItWon) {
   EXPECT_GT(more.score, once.score);
 }
 
+/// The box of PaintedBoxScene without its colours, seen at the truth as one flat colour (a
+/// plain part whose light is not the renderer's: no edge inside its outline), or its left and
+/// right halves in two colours.
+struct PlainBoxScene : PaintedBoxScene {
+  PlainBoxScene() {
+    mesh.colours.clear();
+    bank.mesh = mesh;
+  }
+  /// The frame with the box's mask painted `left` and, right of the truth's centre, `right`.
+  cv::Mat frame(MeshRenderer& renderer, const cv::Scalar& left, const cv::Scalar& right) const {
+    const cv::Mat mask = renderer.render(camera, {truth}).front().mask();
+    cv::Mat out(camera.height, camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
+    out.setTo(left, mask);
+    const int middle = static_cast<int>(camera.project(truth.t).x());
+    out.colRange(middle, out.cols).setTo(right, mask.colRange(middle, mask.cols));
+    return out;
+  }
+};
+
+TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
+  PlainBoxScene s;
+  MeshRenderer renderer(test::context(), s.mesh);
+  PoseObject object;
+  object.bank = &s.bank;
+  object.renderer = &renderer;
+  object.bounding_radius = 0.5f * s.mesh.diameter;
+  const Rendering at_truth = renderer.render(s.camera, {s.truth}).front();
+  const cv::Rect frame_rect(0, 0, s.camera.width, s.camera.height);
+  const DetectorParams params;
+  const auto verify = [&](const cv::Mat& bgr, const Pose& start) {
+    std::vector<PoseCandidate> candidates{s.candidateFrom(start)};
+    fitAndVerifyByContour(candidates, {object}, s.camera, bgr, edgeDistanceMaps(bgr), params);
+    return candidates[0];
+  };
+
+  // One colour: the rendered shading's edges inside (the box's folds) meet nothing, yet the
+  // outline alone is all on the frame's edges, and that verifies it.
+  const cv::Mat plain = s.frame(renderer, {40, 90, 200}, {40, 90, 200});
+  EXPECT_LT(seenChromaSpread(at_truth, frame_rect, plain), kMinChromaSpread);
+  const PoseCandidate right = verify(plain, s.truth);
+  EXPECT_TRUE(right.detection.verified) << right.detection.rejection;
+  EXPECT_TRUE(right.outline_passed);
+  EXPECT_GT(right.detection.contour_edges, 0.9f);
+
+  // Two colours under it: not one plain surface, so every edge counts, the folds' too.
+  const cv::Mat two = s.frame(renderer, {40, 90, 200}, {200, 120, 40});
+  EXPECT_GT(seenChromaSpread(at_truth, frame_rect, two), kMinChromaSpread);
+  const PoseCandidate split = verify(two, s.truth);
+  EXPECT_LT(split.detection.contour_edges, right.detection.contour_edges - 0.1f);
+
+  // The outline asked over a plain surface is ColourOnlyParams::min_plain_outline_support: a
+  // box posed on a larger plain patch (a table, the side of a bigger box) is far from its edges.
+  cv::Mat patch(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::circle(patch, {static_cast<int>(s.camera.project(s.truth.t).x()), static_cast<int>(s.camera.project(s.truth.t).y())},
+             120, {40, 90, 200}, cv::FILLED);
+  const PoseCandidate inside = verify(patch, s.truth);
+  EXPECT_FALSE(inside.detection.verified);
+  EXPECT_FALSE(inside.outline_passed);
+  EXPECT_NE(inside.detection.rejection.find("85 % needed"), std::string::npos) << inside.detection.rejection;
+}
+
 TEST(ColourOnly, TheColourTurnsAreTheCubesTurnsAndEighthTurnsEachOnce) {
   const std::vector<Eigen::Matrix3f> turns = colourTurns();
   ASSERT_EQ(turns.size(), 35u);  // 24 - 1 + 3 x 4
