@@ -447,9 +447,10 @@ struct ColourOnlyParams {
   /// of it on an image edge (0: off, every pose by min_contour_support over all its edges).
   /// Its rendered shading's edges need not be the frame's: on the synthetic sets looked at, the
   /// milk jug's right poses have 42-74 % of all their edges on the frame's and 86-100 % of
-  /// their outline, under a chromaticity spread of 0.01-0.03; wrong poses with 85 % of their
-  /// outline on edges lie over several colours (0.07-0.22), and over one colour reach 84 %.
-  /// Tables 91 / 95: F1 0.84 / 0.77 -> 0.87 / 0.81 (history.md, 2026-12-07 night).
+  /// their outline, under a chromaticity spread of 0.01-0.03; wrong poses with 85 % or more of
+  /// their outline on edges lay over several colours (0.12-0.18) but for one, and the others
+  /// over one colour reached 84 %. Tables 91 / 95: F1 0.84 / 0.77 -> 0.87 / 0.81; held-out
+  /// tables 0.785 -> 0.794 and bins 0.40 -> 0.43 on average (history.md, 2026-12-07 night).
   float min_plain_outline_support = 0.85f;
   /// Meshes with colours: the rendered chromaticity must agree with the frame's this much
   /// (Lin's concordance, -1..1; -1: off). Without depth most wrong poses are another object's
