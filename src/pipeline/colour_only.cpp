@@ -164,18 +164,14 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
           return;
         }
         const bool own_colours = !objects[c.bank()].bank->mesh.colours.empty();
-        d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
-        float needed = cp.min_contour_support;  // of d.contour_edges
-        if (!own_colours && cp.min_plain_outline_support > 0.f) {
-          // Over a surface of one colour the outline alone verifies it, asking more of it: the
-          // frame's light need not put edges where the rendered shading has them.
-          const double spread = seenChromaSpread(rendering, window, bgr);
-          if (spread < kMinChromaSpread) {
-            const auto outline = contourPoints(rendering, poses[i], camera, window, 400, 0.01f, false);
-            d.contour_edges = chamferSupport(outline, poses[i], camera, maps, cp.edge_tolerance_px);
-            needed = cp.min_plain_outline_support;
-          }
-        }
+        // Over a surface of one colour a mesh without colours is verified by its outline alone,
+        // asking more of it: the frame's light need not put edges where the rendered shading has them.
+        const bool plain = !own_colours && cp.min_plain_outline_support > 0.f &&
+                           seenChromaSpread(rendering, window, bgr) < kMinChromaSpread;
+        const auto outline = plain ? contourPoints(rendering, poses[i], camera, window, 400, 0.01f, false)
+                                   : std::vector<ContourPoint>{};
+        d.contour_edges = chamferSupport(plain ? outline : points, poses[i], camera, maps, cp.edge_tolerance_px);
+        const float needed = plain ? cp.min_plain_outline_support : cp.min_contour_support;
         c.outline_passed = !(d.contour_edges < needed);
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
         const bool colour_counts = own_colours && colour.colour_informative;

@@ -26,6 +26,11 @@ bool chroma(const cv::Vec3b& bgr, double& r, double& g) {
   return true;
 }
 
+/// The standard deviation of n (r, g) chromaticities from their sums and sum of squares.
+double chromaSpread(double n, double sr, double sg, double ss) {
+  return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
+}
+
 }  // namespace
 
 double meshChromaSpread(const Mesh& mesh) {
@@ -38,7 +43,7 @@ double meshChromaSpread(const Mesh& mesh) {
     n += 1, sr += r, sg += g, ss += r * r + g * g;
   }
   if (n < 2) return 0.0;
-  return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
+  return chromaSpread(n, sr, sg, ss);
 }
 
 double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr) {
@@ -59,7 +64,7 @@ double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, cons
     }
   }
   if (n < kMinColourPixels) return std::numeric_limits<double>::quiet_NaN();
-  return std::sqrt(std::max(0.0, ss / n - (sr * sr + sg * sg) / (n * n)));
+  return chromaSpread(n, sr, sg, ss);
 }
 
 AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr,
