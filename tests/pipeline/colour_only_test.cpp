@@ -367,8 +367,8 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   const Rendering at_truth = renderer.render(s.camera, {s.truth}).front();
   const cv::Rect frame_rect(0, 0, s.camera.width, s.camera.height);
   const DetectorParams params;
-  const auto verify = [&](const cv::Mat& bgr, const Pose& start) {
-    std::vector<PoseCandidate> candidates{s.candidateFrom(start)};
+  const auto verifyAtTruth = [&](const cv::Mat& bgr) {
+    std::vector<PoseCandidate> candidates{s.candidateFrom(s.truth)};
     fitAndVerifyByContour(candidates, {object}, s.camera, bgr, edgeDistanceMaps(bgr), params);
     return candidates[0];
   };
@@ -377,7 +377,7 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   // outline alone is all on the frame's edges, and that verifies it.
   const cv::Mat plain = s.frame(renderer, {40, 90, 200}, {40, 90, 200});
   EXPECT_LT(seenChromaSpread(at_truth, frame_rect, plain), kMinChromaSpread);
-  const PoseCandidate right = verify(plain, s.truth);
+  const PoseCandidate right = verifyAtTruth(plain);
   EXPECT_TRUE(right.detection.verified) << right.detection.rejection;
   EXPECT_TRUE(right.outline_passed);
   EXPECT_GT(right.detection.contour_edges, 0.9f);
@@ -385,7 +385,7 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   // Two colours under it: not one plain surface, so every edge counts, the folds' too.
   const cv::Mat two = s.frame(renderer, {40, 90, 200}, {200, 120, 40});
   EXPECT_GT(seenChromaSpread(at_truth, frame_rect, two), kMinChromaSpread);
-  const PoseCandidate split = verify(two, s.truth);
+  const PoseCandidate split = verifyAtTruth(two);
   EXPECT_LT(split.detection.contour_edges, right.detection.contour_edges - 0.1f);
 
   // The outline asked over a plain surface is ColourOnlyParams::min_plain_outline_support: a
@@ -393,7 +393,7 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   cv::Mat patch(s.camera.height, s.camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
   cv::circle(patch, {static_cast<int>(s.camera.project(s.truth.t).x()), static_cast<int>(s.camera.project(s.truth.t).y())},
              120, {40, 90, 200}, cv::FILLED);
-  const PoseCandidate inside = verify(patch, s.truth);
+  const PoseCandidate inside = verifyAtTruth(patch);
   EXPECT_FALSE(inside.detection.verified);
   EXPECT_FALSE(inside.outline_passed);
   EXPECT_NE(inside.detection.rejection.find("85 % needed"), std::string::npos) << inside.detection.rejection;
