@@ -73,6 +73,11 @@ struct Detection {
   /// Colour only: of the frame's edge pixels under the pose's mask, the share that the model's
   /// own edges (outline, colour edges) explain; a pose laid on clutter covers edges it cannot.
   float explained_edges = 0.f;
+  /// Colour only, a mesh without colours over a surface of one colour: the share of its outline
+  /// alone (silhouette and depth steps, not the shading's edges) that meets an image edge, the
+  /// test such a pose passes instead of `contour_edges` (ColourOnlyParams::min_plain_outline_support).
+  /// It gates only; the score keeps `contour_edges`. NaN where not measured.
+  float plain_outline_edges = std::numeric_limits<float>::quiet_NaN();
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group

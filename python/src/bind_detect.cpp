@@ -186,6 +186,7 @@ py::dict detectionDict(const Detection& d) {
   out["depth_fit"] = tidy(d.depth_fit);
   out["colour_only"] = d.colour_only;
   out["explained_edges"] = tidy(d.explained_edges);
+  if (std::isfinite(d.plain_outline_edges)) out["plain_outline_edges"] = tidy(d.plain_outline_edges);
   out["silhouette_support"] = tidy(d.silhouette_support);
   out["contour_edges"] = tidy(d.contour_edges);
   if (std::isfinite(d.outline_on_edges)) out["outline_on_edges"] = tidy(d.outline_on_edges);
@@ -387,6 +388,13 @@ leaves the config as it was.)")
                              "Posed without depth: fitted to the image's edges, no depth test ran")
       .def_property_readonly("explained_edges", [](const PyDetection& p) { return tidy(p.d.explained_edges); },
                              "Colour only: share of the frame's edges under the pose's mask that the model's edges explain")
+      .def_property_readonly("plain_outline_edges",
+                             [](const PyDetection& p) -> py::object {
+                               if (!std::isfinite(p.d.plain_outline_edges)) return py::none();
+                               return py::float_(tidy(p.d.plain_outline_edges));
+                             },
+                             "Colour only, a mesh without colours over one colour: share of its outline alone on "
+                             "image edges, the test it passed instead of contour_edges; None where not measured")
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
       .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
       .def_property_readonly("outline_on_edges",

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <numeric>
 #include <optional>
 
@@ -168,11 +169,16 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         // asking more of it: the frame's light need not put edges where the rendered shading has them.
         const bool plain = !own_colours && cp.min_plain_outline_support > 0.f &&
                            seenChromaSpread(rendering, window, bgr) < kMinChromaSpread;
-        const auto outline = plain ? contourPoints(rendering, poses[i], camera, window, 400, 0.01f, false)
-                                   : std::vector<ContourPoint>{};
-        d.contour_edges = chamferSupport(plain ? outline : points, poses[i], camera, maps, cp.edge_tolerance_px);
+        d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
+        // The outline alone gates; the score keeps every edge, so that a plain mesh's pose
+        // does not outrank another object's for having fewer edges to explain.
+        d.plain_outline_edges =
+            plain ? chamferSupport(contourPoints(rendering, poses[i], camera, window, 400, 0.01f, false), poses[i],
+                                   camera, maps, cp.edge_tolerance_px)
+                  : std::numeric_limits<float>::quiet_NaN();
+        const float tested = plain ? d.plain_outline_edges : d.contour_edges;
         const float needed = plain ? cp.min_plain_outline_support : cp.min_contour_support;
-        c.outline_passed = !(d.contour_edges < needed);
+        c.outline_passed = !(tested < needed);
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
         const bool colour_counts = own_colours && colour.colour_informative;
         d.colour_agreement = colour_counts ? colour.colour : 1.f;
@@ -180,8 +186,8 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
         d.score = d.contour_edges * d.explained_edges * (colour_counts ? 0.5f * (1.f + colour.colour) : 1.f);
         if (!c.outline_passed)
-          d.rejection = fmt::format("{:.0f} % of its outline meets an image edge, {:.0f} % needed",
-                                    100.f * d.contour_edges, 100.f * needed);
+          d.rejection = fmt::format("{:.0f} % of its {} meets an image edge, {:.0f} % needed", 100.f * tested,
+                                    plain ? "outline alone" : "outline", 100.f * needed);
         else if (const float agreement = objects[c.bank()].colourful ? cp.min_colourful_agreement : cp.min_colour_agreement;
                  colour_counts && agreement > -1.f && colour.colour < agreement)
           d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour, agreement);

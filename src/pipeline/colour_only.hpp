@@ -30,7 +30,7 @@ void scoreBySimilarity(std::vector<Hypothesis>& hypotheses);
 /// Stages 7-8 without depth for each candidate: rounds of rendering, outline extraction and
 /// the directional chamfer fit (contour_fit.hpp), then the outline's support and the colour
 /// agreement at the final pose. Fills detection (pose, score, contour_edges, explained_edges,
-/// colour_agreement, verified, rejection). `camera`: the frame's; `bgr`: its colour image.
+/// plain_outline_edges, colour_agreement, verified, rejection). `camera`: the frame's; `bgr`: its colour image.
 void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::vector<PoseObject>& objects,
                            const Camera& camera, const cv::Mat& bgr, const EdgeDistanceMaps& maps,
                            const DetectorParams& params, const ContourFitParams& fit_params = {});

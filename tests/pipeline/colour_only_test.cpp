@@ -380,13 +380,17 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   const PoseCandidate right = verifyAtTruth(plain);
   EXPECT_TRUE(right.detection.verified) << right.detection.rejection;
   EXPECT_TRUE(right.outline_passed);
-  EXPECT_GT(right.detection.contour_edges, 0.9f);
+  EXPECT_GT(right.detection.plain_outline_edges, 0.9f);
+  // The score keeps every edge: the unmet folds count there, so a plain part does not outrank
+  // another object's pose for having fewer edges to explain.
+  EXPECT_LT(right.detection.contour_edges, right.detection.plain_outline_edges - 0.1f);
 
-  // Two colours under it: not one plain surface, so every edge counts, the folds' too.
+  // Two colours under it: not one plain surface, so every edge counts in the test, the folds' too.
   const cv::Mat two = s.frame(renderer, {40, 90, 200}, {200, 120, 40});
   EXPECT_GT(seenChromaSpread(at_truth, frame_rect, two), kMinChromaSpread);
   const PoseCandidate split = verifyAtTruth(two);
-  EXPECT_LT(split.detection.contour_edges, right.detection.contour_edges - 0.1f);
+  EXPECT_TRUE(std::isnan(split.detection.plain_outline_edges));
+  EXPECT_LT(split.detection.contour_edges, right.detection.plain_outline_edges - 0.1f);
 
   // The outline asked over a plain surface is ColourOnlyParams::min_plain_outline_support: a
   // box posed on a larger plain patch (a table, the side of a bigger box) is far from its edges.
@@ -396,6 +400,7 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   const PoseCandidate inside = verifyAtTruth(patch);
   EXPECT_FALSE(inside.detection.verified);
   EXPECT_FALSE(inside.outline_passed);
+  EXPECT_NE(inside.detection.rejection.find("of its outline alone"), std::string::npos) << inside.detection.rejection;
   EXPECT_NE(inside.detection.rejection.find("85 % needed"), std::string::npos) << inside.detection.rejection;
 }
 
