@@ -124,6 +124,9 @@ def test_colour_only_with_depth_none(icbin, icbin_bank):
     for d in list(result.detections) + list(result.rejected):
         assert d.colour_only and d.to_dict()["colour_only"]
         assert 0.0 <= d.explained_edges <= 1.0
+        # Measured only for a mesh without colours over a surface of one colour.
+        assert d.plain_outline_edges is None or 0.0 <= d.plain_outline_edges <= 1.0
+        assert ("plain_outline_edges" in d.to_dict()) == (d.plain_outline_edges is not None)
     doc = json.loads(result.to_json())
     assert doc["depth"] == ""
     assert all(d["colour_only"] for d in doc["detections"])
