@@ -452,6 +452,15 @@ struct ColourOnlyParams {
   /// over one colour reached 84 %. Tables 91 / 95: F1 0.84 / 0.77 -> 0.87 / 0.81; held-out
   /// tables 0.785 -> 0.794 and bins 0.40 -> 0.43 on average (history.md, 2026-12-07 night).
   float min_plain_outline_support = 0.85f;
+  /// A mesh without colours posed over several colours (the spread kMinChromaSpread or more)
+  /// needs this share of all its edges supported, where min_contour_support is less. A right
+  /// pose of a part the mesh does not colour shows the part's one colour; on the synthetic
+  /// tables and bins looked at, all 42 right milk-jug poses found lay over one colour, while
+  /// 7 of the jug's 9 wrong poses lay over several (on the painted carton and cup, 0.51-0.71 of
+  /// their edges supported); right jugs reach 0.34-0.76 over one colour. A printed part whose
+  /// mesh has no colours is held to it too: colour only found none of IC-BIN's printed
+  /// cartons right (26-230 px off against the depth path's poses), at 0.56-0.88.
+  float min_uncoloured_mixed_support = 0.8f;
   /// Meshes with colours: the rendered chromaticity must agree with the frame's this much
   /// (Lin's concordance, -1..1; -1: off). Without depth most wrong poses are another object's
   /// place or clutter, which agree 0.0-0.2, where right poses agree 0.5-0.97 on synthetic sets

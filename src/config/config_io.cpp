@@ -59,6 +59,7 @@ std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
       {"colour_only", "edge_tolerance_px", "frames without depth: an outline point within this of an edge along it is supported, pixels", &p.colour_only.edge_tolerance_px, aboveUpTo(0, 20)},
       {"colour_only", "min_contour_support", "frames without depth: share of the outline a pose needs supported, 0..1", &p.colour_only.min_contour_support, closed(0, 1)},
       {"colour_only", "min_plain_outline_support", "frames without depth, meshes without colours over a surface of one colour: share of the outline alone a pose needs supported (0: off)", &p.colour_only.min_plain_outline_support, closed(0, 1)},
+      {"colour_only", "min_uncoloured_mixed_support", "frames without depth, meshes without colours over several colours: share of all their edges a pose needs supported (at most colour_only.min_contour_support: off)", &p.colour_only.min_uncoloured_mixed_support, closed(0, 1)},
       {"colour_only", "min_colour_agreement", "frames without depth, meshes with colours: rendered and seen chromaticity must agree this much (-1: off)", &p.colour_only.min_colour_agreement, closed(-1, 1)},
       {"colour_only", "min_colourful_agreement", "the same for meshes whose colours vary (painted, printed)", &p.colour_only.min_colourful_agreement, closed(-1, 1)},
       {"colour_only", "try_turns", "frames without depth: each fitted pose also fitted from its object's look-alike turns, the best kept", &p.colour_only.try_turns},

@@ -167,8 +167,11 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         const bool own_colours = !objects[c.bank()].bank->mesh.colours.empty();
         // Over a surface of one colour a mesh without colours is verified by its outline alone,
         // asking more of it: the frame's light need not put edges where the rendered shading has them.
-        const bool plain = !own_colours && cp.min_plain_outline_support > 0.f &&
-                           seenChromaSpread(rendering, window, bgr) < kMinChromaSpread;
+        // Over several colours, one that has none of its own is most often on another object.
+        const float spread = own_colours ? std::numeric_limits<float>::quiet_NaN()
+                                         : seenChromaSpread(rendering, window, bgr);
+        const bool plain = cp.min_plain_outline_support > 0.f && spread < kMinChromaSpread;
+        const bool mixed = spread >= kMinChromaSpread;
         d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
         // The outline alone gates; the score keeps every edge, so that a plain mesh's pose
         // does not outrank another object's for having fewer edges to explain.
@@ -177,7 +180,9 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
                                    camera, maps, cp.edge_tolerance_px)
                   : std::numeric_limits<float>::quiet_NaN();
         const float tested = plain ? d.plain_outline_edges : d.contour_edges;
-        const float needed = plain ? cp.min_plain_outline_support : cp.min_contour_support;
+        const float needed = plain   ? cp.min_plain_outline_support
+                             : mixed ? std::max(cp.min_contour_support, cp.min_uncoloured_mixed_support)
+                                     : cp.min_contour_support;
         c.outline_passed = !(tested < needed);
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
         const bool colour_counts = own_colours && colour.colour_informative;
@@ -186,8 +191,9 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         d.explained_edges = explainedEdgeShare(rendering, window, maps, cp.edge_tolerance_px);
         d.score = d.contour_edges * d.explained_edges * (colour_counts ? 0.5f * (1.f + colour.colour) : 1.f);
         if (!c.outline_passed)
-          d.rejection = fmt::format("{:.0f} % of its {} meets an image edge, {:.0f} % needed", 100.f * tested,
-                                    plain ? "outline alone" : "outline", 100.f * needed);
+          d.rejection = fmt::format("{:.0f} % of its {} meets an image edge, {:.0f} % needed{}", 100.f * tested,
+                                    plain ? "outline alone" : "outline", 100.f * needed,
+                                    mixed ? " (a mesh without colours over several colours)" : "");
         else if (const float agreement = objects[c.bank()].colourful ? cp.min_colourful_agreement : cp.min_colour_agreement;
                  colour_counts && agreement > -1.f && colour.colour < agreement)
           d.rejection = fmt::format("its colours agree {:.2f} with the frame's, {:.2f} needed", colour.colour, agreement);

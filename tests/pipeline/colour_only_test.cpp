@@ -357,7 +357,7 @@ struct PlainBoxScene : PaintedBoxScene {
   }
 };
 
-TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
+TEST(ColourOnly, AMeshWithoutColoursIsVerifiedByItsOutlineOverOneColourAndByMoreEdgesOverSeveral) {
   PlainBoxScene s;
   MeshRenderer renderer(test::context(), s.mesh);
   PoseObject object;
@@ -367,9 +367,9 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   const Rendering at_truth = renderer.render(s.camera, {s.truth}).front();
   const cv::Rect frame_rect(0, 0, s.camera.width, s.camera.height);
   const DetectorParams params;
-  const auto verifyAtTruth = [&](const cv::Mat& bgr) {
+  const auto verifyAtTruth = [&](const cv::Mat& bgr, const DetectorParams& p = DetectorParams{}) {
     std::vector<PoseCandidate> candidates{s.candidateFrom(s.truth)};
-    fitAndVerifyByContour(candidates, {object}, s.camera, bgr, edgeDistanceMaps(bgr), params);
+    fitAndVerifyByContour(candidates, {object}, s.camera, bgr, edgeDistanceMaps(bgr), p);
     return candidates[0];
   };
 
@@ -391,6 +391,16 @@ TEST(ColourOnly, AMeshWithoutColoursOverOneColourIsVerifiedByItsOutlineAlone) {
   const PoseCandidate split = verifyAtTruth(two);
   EXPECT_TRUE(std::isnan(split.detection.plain_outline_edges));
   EXPECT_LT(split.detection.contour_edges, right.detection.plain_outline_edges - 0.1f);
+  // There a mesh without colours needs ColourOnlyParams::min_uncoloured_mixed_support of them:
+  // a right pose shows the part's one colour, a pose over several is mostly on another object.
+  EXPECT_LT(split.detection.contour_edges, params.colour_only.min_uncoloured_mixed_support);
+  EXPECT_FALSE(split.detection.verified);
+  EXPECT_NE(split.detection.rejection.find("over several colours"), std::string::npos) << split.detection.rejection;
+  DetectorParams lenient;
+  lenient.colour_only.min_uncoloured_mixed_support = 0.f;  // off: min_contour_support, as with colours
+  const PoseCandidate split_lenient = verifyAtTruth(two, lenient);
+  EXPECT_GE(split_lenient.detection.contour_edges, lenient.colour_only.min_contour_support);
+  EXPECT_TRUE(split_lenient.detection.verified) << split_lenient.detection.rejection;
 
   // The outline asked over a plain surface is ColourOnlyParams::min_plain_outline_support: a
   // box posed on a larger plain patch (a table, the side of a bigger box) is far from its edges.
