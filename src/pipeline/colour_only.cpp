@@ -167,7 +167,8 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         const bool own_colours = !objects[c.bank()].bank->mesh.colours.empty();
         // Over a surface of one colour a mesh without colours is verified by its outline alone,
         // asking more of it: the frame's light need not put edges where the rendered shading has them.
-        // Over several colours, one that has none of its own is most often on another object.
+        // Over several colours it is held to more of every edge (min_uncoloured_mixed_support):
+        // a right pose shows the part's one colour, a wrong one lies mostly on another object.
         const float spread = own_colours ? std::numeric_limits<float>::quiet_NaN()
                                          : seenChromaSpread(rendering, window, bgr);
         const bool plain = cp.min_plain_outline_support > 0.f && spread < kMinChromaSpread;
