@@ -172,7 +172,8 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
         const float spread = own_colours ? std::numeric_limits<float>::quiet_NaN()
                                          : seenChromaSpread(rendering, window, bgr);
         const bool plain = cp.min_plain_outline_support > 0.f && spread < kMinChromaSpread;
-        const bool mixed = spread >= kMinChromaSpread;
+        const bool mixed =
+            spread >= kMinChromaSpread && cp.min_uncoloured_mixed_support > cp.min_contour_support;
         d.contour_edges = chamferSupport(points, poses[i], camera, maps, cp.edge_tolerance_px);
         // The outline alone gates; the score keeps every edge, so that a plain mesh's pose
         // does not outrank another object's for having fewer edges to explain.
@@ -182,7 +183,7 @@ void fitAndVerifyByContour(std::vector<PoseCandidate>& candidates, const std::ve
                   : std::numeric_limits<float>::quiet_NaN();
         const float tested = plain ? d.plain_outline_edges : d.contour_edges;
         const float needed = plain   ? cp.min_plain_outline_support
-                             : mixed ? std::max(cp.min_contour_support, cp.min_uncoloured_mixed_support)
+                             : mixed ? cp.min_uncoloured_mixed_support
                                      : cp.min_contour_support;
         c.outline_passed = !(tested < needed);
         const AppearanceAgreement colour = colourAgreement(rendering, window, bgr);
