@@ -165,6 +165,12 @@ py::object lookAlikeDict(const Detection& d) {
   return out;
 }
 
+/// A share or ratio that is NaN where it was not measured: None there.
+py::object measuredOrNone(float value) {
+  if (!std::isfinite(value)) return py::none();
+  return py::float_(tidy(value));
+}
+
 py::dict detectionDict(const Detection& d) {
   py::dict out;
   out["object"] = d.object;
@@ -389,24 +395,14 @@ leaves the config as it was.)")
       .def_property_readonly("explained_edges", [](const PyDetection& p) { return tidy(p.d.explained_edges); },
                              "Colour only: share of the frame's edges under the pose's mask that the model's edges explain")
       .def_property_readonly("plain_outline_edges",
-                             [](const PyDetection& p) -> py::object {
-                               if (!std::isfinite(p.d.plain_outline_edges)) return py::none();
-                               return py::float_(tidy(p.d.plain_outline_edges));
-                             },
+                             [](const PyDetection& p) { return measuredOrNone(p.d.plain_outline_edges); },
                              "Colour only, a mesh without colours over one colour: share of its outline alone on "
                              "image edges, the test it passed instead of contour_edges; None where not measured")
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
       .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
-      .def_property_readonly("outline_on_edges",
-                             [](const PyDetection& p) -> py::object {
-                               if (!std::isfinite(p.d.outline_on_edges)) return py::none();
-                               return py::float_(tidy(p.d.outline_on_edges));
-                             })
+      .def_property_readonly("outline_on_edges", [](const PyDetection& p) { return measuredOrNone(p.d.outline_on_edges); })
       .def_property_readonly("silhouette_scale",
-                             [](const PyDetection& p) -> py::object {
-                               if (!std::isfinite(p.d.silhouette_scale)) return py::none();
-                               return py::float_(tidy(p.d.silhouette_scale));
-                             },
+                             [](const PyDetection& p) { return measuredOrNone(p.d.silhouette_scale); },
                              "The scene's silhouette around the outline, times the model's (a larger look-alike: "
                              "over 1); None where not measured")
       .def_property_readonly("colour_agreement", [](const PyDetection& p) { return tidy(p.d.colour_agreement); },
