@@ -86,9 +86,14 @@ TEST(FeaturesReference, ColourQuantizationMatchesOpenCvColorGradient) {
 
 // OpenCV bins depth normals through a 20-cell lookup table of (nx, ny, nz), so its sector
 // edges are jagged; vkpose bins the exact least-squares direction into 45-degree sectors
-// (same bits, same sector centres). They agree on the large majority of pixels.
+// (same bits, same sector centres). They agree on the large majority of pixels of real
+// sensor frames (LM-O 7.5 %, IC-BIN 9.4 % differ). A synthetic stand-in is no test of that: a
+// flat surface has one normal, and where that lies near a jagged sector edge a whole bin floor
+// or wall changes sector at once (the bin stand-in: 22 % differ, two thirds of them between
+// sectors 16 and 32 or 64 and 32), so this test needs the real frames.
 TEST(FeaturesReference, DepthQuantizationAgreesWithOpenCvDepthNormal) {
-  for (const auto& frame : {test::lmoFrameOrStandIn(), test::icbinFrameOrStandIn()}) {
+  VKPOSE_REQUIRE_SHARED_DATA();
+  for (const auto& frame : {test::lmoFrame(), test::icbinFrame()}) {
     auto modality = cv::linemod::Modality::create("DepthNormal");
     cv::Mat theirs;
     modality->process(frame.depth_mm, cv::Mat())->quantize(theirs);
