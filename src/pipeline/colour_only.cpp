@@ -473,11 +473,13 @@ DetectionResult Detector::detectColourOnly(const LinemodFrame& frame, const Came
   // Several rotation starts a hypothesis (the largest groups of its templates' rotations):
   // without depth a cluster mixes views whose outlines look alike more often, and the fit
   // cannot turn far. The best-supported start of each hypothesis is kept. (No start by fit:
-  // scoreBySimilarity leaves the members without a depth fit.)
+  // scoreBySimilarity leaves the members without a depth fit. The best match's group instead:
+  // a jug lying in plain sight, its cluster's best template 5-8 degrees from the truth, had six
+  // larger groups of its other side.)
   std::vector<PoseCandidate> candidates;
   std::vector<std::size_t> hypothesis_of;
   for (std::size_t k = 0; k < hypotheses.size(); ++k)
-    for (PoseCandidate& c : hypothesisStarts(hypotheses[k], banks_, camera, params_, params_.colour_only.starts)) {
+    for (PoseCandidate& c : hypothesisStarts(hypotheses[k], banks_, camera, params_, params_.colour_only.starts, true)) {
       candidates.push_back(std::move(c));
       hypothesis_of.push_back(k);
     }

@@ -142,7 +142,8 @@ std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypoth
 }
 
 std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vector<TemplateBank>& banks,
-                                            const Camera& camera, const DetectorParams& params, int starts) {
+                                            const Camera& camera, const DetectorParams& params, int starts,
+                                            bool best_match_start) {
   const InitialPoseParams& ip = params.initial_pose;
   const TemplateBank& bank = banks[static_cast<std::size_t>(h.bank)];
   const InitialRotation rot = initialRotation(h, bank, camera, ip, params.score, starts);
@@ -156,6 +157,7 @@ std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vect
   start(rot.R, rot.group_size);
   for (const RotationStart& s : rot.more) start(s.R, s.votes);
   if (rot.by_fit) start(rot.by_fit->R, rot.by_fit->votes);
+  if (best_match_start && rot.by_best_match) start(rot.by_best_match->R, rot.by_best_match->votes);
   return out;
 }
 

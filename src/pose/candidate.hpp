@@ -130,10 +130,12 @@ std::vector<PoseCandidate> startCandidates(const std::vector<Hypothesis>& hypoth
                                            const DetectorParams& params);
 
 /// One hypothesis's starts: its largest rotation group, the next largest up to `starts` in all,
-/// and the group that fits best by stage 4 where that is another (initialRotation), each posed
-/// on its viewing ray.
+/// the group that fits best by stage 4 where that is another (initialRotation) and, with
+/// `best_match_start`, the group of its best-matching template where that is another, each
+/// posed on its viewing ray.
 std::vector<PoseCandidate> hypothesisStarts(const Hypothesis& h, const std::vector<TemplateBank>& banks,
-                                            const Camera& camera, const DetectorParams& params, int starts);
+                                            const Camera& camera, const DetectorParams& params, int starts,
+                                            bool best_match_start = false);
 
 /// Stage 8's tests as `bank`'s object gets them: a part under 10 cm asks more of its colour
 /// (small_part_min_colour_agreement), and one that is a body of revolution (trained

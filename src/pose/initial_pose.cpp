@@ -85,9 +85,13 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
                                        weights);
   out.R = groups.front().mean;
   out.group_size = static_cast<int>(groups.front().members.size());
-  for (std::size_t g = 1; g < groups.size() && g < static_cast<std::size_t>(std::max(starts, 1)); ++g) {
+  const std::size_t started = std::min(groups.size(), static_cast<std::size_t>(std::max(starts, 1)));
+  for (std::size_t g = 1; g < started; ++g) {
     out.more.push_back({groups[g].mean, static_cast<int>(groups[g].members.size())});
   }
+  for (std::size_t g = started; g < groups.size(); ++g)
+    if (std::find(groups[g].members.begin(), groups[g].members.end(), 0) != groups[g].members.end())
+      out.by_best_match = RotationStart{groups[g].mean, static_cast<int>(groups[g].members.size())};
   if (!params.second_start_by_fit) return out;
   // The scored members again, each weighted by its own fit to the scene (stage 4's), groups
   // ranked by the sum.

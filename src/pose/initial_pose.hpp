@@ -60,6 +60,10 @@ struct InitialRotation {
   /// With `starts` > 1: the next largest groups, largest first, up to starts - 1 (by_fit is
   /// left out when it is one of them).
   std::vector<RotationStart> more;
+  /// The group of the best-matching template (the first member), when it is neither R nor
+  /// one of `more`: without depth no member has a fit to vote by_fit, and in a cluster of
+  /// look-alike views the best match can be right where the largest groups are not.
+  std::optional<RotationStart> by_best_match;
 };
 
 /// Stage 6, rotation: every member's template rotation is turned onto the viewing ray through

@@ -154,6 +154,44 @@ TEST(InitialRotation, StartsAlsoFromTheGroupThatFitsTheSceneBest) {
   EXPECT_FALSE(r.by_fit.has_value());  // the best fit is that group: no third start
 }
 
+// Without depth no member has a fit to choose a second start by; a cluster of look-alike views
+// (a jug lying on either side) can hold more templates of the wrong side than of the right
+// one, whose template matched best. That group is a start too where it is none of the others.
+TEST(InitialRotation, StartsAlsoFromTheBestMatchsGroupWhereTheLargestLeaveItOut) {
+  const Eigen::Vector3f x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  // Template 0, the best match, alone at 60 degrees about y; three about the identity, two at
+  // 70-72 degrees about x.
+  const TemplateBank bank = rotationBank({rot(60, y), rot(3, z), rot(70, x), rot(-3, z), rot(0, y), rot(72, x)});
+  const Camera camera;
+  Hypothesis h;
+  h.x = static_cast<float>(camera.cx);
+  h.y = static_cast<float>(camera.cy);
+  h.distance = 0.7f;
+  for (int i = 0; i < 6; ++i) h.members.push_back({i, 0, 0, 95.f - float(i), h.x, h.y});
+  h.best_member = 0;
+  InitialRotation r = initialRotation(h, bank, camera, {}, {}, 2);
+  EXPECT_EQ(r.group_size, 3);
+  ASSERT_EQ(r.more.size(), 1u);
+  EXPECT_EQ(r.more[0].votes, 2);
+  ASSERT_TRUE(r.by_best_match.has_value());
+  EXPECT_EQ(r.by_best_match->votes, 1);
+  EXPECT_LT(rotationDistance(r.by_best_match->R, rot(60, y)) / kDeg, 0.5f);
+  // Only frames without depth start from it.
+  EXPECT_EQ(hypothesisStarts(h, {bank}, camera, {}, 2).size(), 2u);
+  const std::vector<PoseCandidate> starts = hypothesisStarts(h, {bank}, camera, {}, 2, true);
+  ASSERT_EQ(starts.size(), 3u);
+  EXPECT_LT(rotationDistance(starts[2].start.R, rot(60, y)) / kDeg, 0.5f);
+  // Three starts reach its group: none more.
+  r = initialRotation(h, bank, camera, {}, {}, 3);
+  EXPECT_EQ(r.more.size(), 2u);
+  EXPECT_FALSE(r.by_best_match.has_value());
+  // The best match in the largest group: none more.
+  h.members[0].similarity = 80.f;
+  std::stable_sort(h.members.begin(), h.members.end(),
+                   [](const ClusterMember& a, const ClusterMember& b) { return a.similarity > b.similarity; });
+  EXPECT_FALSE(initialRotation(h, bank, camera, {}, {}, 2).by_best_match.has_value());
+}
+
 /// The scene: a box on a wall at 0.8 m; the hypothesis: the same box rendered `offset` away.
 struct TranslationCase {
   Camera camera;
