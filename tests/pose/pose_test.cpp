@@ -83,6 +83,18 @@ TemplateBank rotationBank(const std::vector<Eigen::Matrix3f>& rotations) {
   return bank;
 }
 
+/// A hypothesis at the image centre at 0.7 m whose members are templates 0 .. n-1, all matched
+/// there, best first (similarity `best`, then one less each).
+Hypothesis centredHypothesis(const Camera& camera, int n, float best) {
+  Hypothesis h;
+  h.x = static_cast<float>(camera.cx);
+  h.y = static_cast<float>(camera.cy);
+  h.distance = 0.7f;
+  for (int i = 0; i < n; ++i) h.members.push_back({i, 0, 0, best - float(i), h.x, h.y});
+  h.best_member = 0;
+  return h;
+}
+
 TEST(InitialRotation, TakesTheLargestGroupAndTurnsItOntoTheViewingRay) {
   const TemplateBank bank = rotationBank({rot(3, {0, 0, 1}), rot(70, {1, 0, 0}), rot(-3, {0, 0, 1}), rot(0, {0, 1, 0})});
   const Camera camera;
@@ -112,11 +124,7 @@ TEST(InitialRotation, StartsAlsoFromTheGroupThatFitsTheSceneBest) {
   const Eigen::Vector3f x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
   const TemplateBank bank = rotationBank({rot(3, z), rot(70, x), rot(-3, z), rot(0, y), rot(72, x)});
   const Camera camera;
-  Hypothesis h;
-  h.x = static_cast<float>(camera.cx);
-  h.y = static_cast<float>(camera.cy);
-  h.distance = 0.7f;
-  for (int i = 0; i < 5; ++i) h.members.push_back({i, 0, 0, 90.f - float(i), h.x, h.y});
+  Hypothesis h = centredHypothesis(camera, 5, 90.f);
   const auto scored = [&](float largest_error, float other_error) {
     h.member_scores.assign(5, {});
     for (int i = 0; i < 5; ++i) {
@@ -163,12 +171,7 @@ TEST(InitialRotation, StartsAlsoFromTheBestMatchsGroupWhereTheLargestLeaveItOut)
   // 70-72 degrees about x.
   const TemplateBank bank = rotationBank({rot(60, y), rot(3, z), rot(70, x), rot(-3, z), rot(0, y), rot(72, x)});
   const Camera camera;
-  Hypothesis h;
-  h.x = static_cast<float>(camera.cx);
-  h.y = static_cast<float>(camera.cy);
-  h.distance = 0.7f;
-  for (int i = 0; i < 6; ++i) h.members.push_back({i, 0, 0, 95.f - float(i), h.x, h.y});
-  h.best_member = 0;
+  Hypothesis h = centredHypothesis(camera, 6, 95.f);
   InitialRotation r = initialRotation(h, bank, camera, {}, {}, 2);
   EXPECT_EQ(r.group_size, 3);
   ASSERT_EQ(r.more.size(), 1u);
