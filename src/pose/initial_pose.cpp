@@ -89,9 +89,11 @@ InitialRotation initialRotation(const Hypothesis& h, const TemplateBank& bank, c
   for (std::size_t g = 1; g < started; ++g) {
     out.more.push_back({groups[g].mean, static_cast<int>(groups[g].members.size())});
   }
-  for (std::size_t g = started; g < groups.size(); ++g)
-    if (std::find(groups[g].members.begin(), groups[g].members.end(), 0) != groups[g].members.end())
+  for (std::size_t g = started; g < groups.size(); ++g)  // the one group that holds member 0
+    if (std::find(groups[g].members.begin(), groups[g].members.end(), 0) != groups[g].members.end()) {
       out.by_best_match = RotationStart{groups[g].mean, static_cast<int>(groups[g].members.size())};
+      break;
+    }
   if (!params.second_start_by_fit) return out;
   // The scored members again, each weighted by its own fit to the scene (stage 4's), groups
   // ranked by the sum.
