@@ -78,6 +78,10 @@ struct Detection {
   /// test such a pose passes instead of `contour_edges` (ColourOnlyParams::min_plain_outline_support).
   /// It gates only; the score keeps `contour_edges`. NaN where not measured.
   float plain_outline_edges = std::numeric_limits<float>::quiet_NaN();
+  /// Colour only: how well the frame's colours tell the pose's mask from a band around it
+  /// (0..1: 0 the same colours on both sides); the score is multiplied by a power of it
+  /// (ColourOnlyParams::region_contrast_power). NaN where not measured.
+  float region_contrast = std::numeric_limits<float>::quiet_NaN();
   double icp_fitness = 0;      ///< mean squared pair distance after ICP, m^2
   int icp_iterations = 0;
   int rotation_votes = 0;      ///< templates in the largest rotation group

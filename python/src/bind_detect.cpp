@@ -193,6 +193,7 @@ py::dict detectionDict(const Detection& d) {
   out["colour_only"] = d.colour_only;
   out["explained_edges"] = tidy(d.explained_edges);
   if (std::isfinite(d.plain_outline_edges)) out["plain_outline_edges"] = tidy(d.plain_outline_edges);
+  if (std::isfinite(d.region_contrast)) out["region_contrast"] = tidy(d.region_contrast);
   out["silhouette_support"] = tidy(d.silhouette_support);
   out["contour_edges"] = tidy(d.contour_edges);
   if (std::isfinite(d.outline_on_edges)) out["outline_on_edges"] = tidy(d.outline_on_edges);
@@ -398,6 +399,9 @@ leaves the config as it was.)")
                              [](const PyDetection& p) { return measuredOrNone(p.d.plain_outline_edges); },
                              "Colour only, a mesh without colours over one colour: share of its outline alone on "
                              "image edges, the test it passed instead of contour_edges; None where not measured")
+      .def_property_readonly("region_contrast", [](const PyDetection& p) { return measuredOrNone(p.d.region_contrast); },
+                             "Colour only: how well the frame's colours tell the pose's mask from a band around it "
+                             "(0..1); None where not measured")
       .def_property_readonly("silhouette_support", [](const PyDetection& p) { return tidy(p.d.silhouette_support); })
       .def_property_readonly("contour_edges", [](const PyDetection& p) { return tidy(p.d.contour_edges); })
       .def_property_readonly("outline_on_edges", [](const PyDetection& p) { return measuredOrNone(p.d.outline_on_edges); })

@@ -66,6 +66,7 @@ std::vector<ConfigField> hypothesisFields(DetectorParams& p) {
       {"colour_only", "tilt_restart_deg", "frames without depth: each fitted pose also fitted tilted this much both ways about the camera's x and y axes, degrees (0: off)", &p.colour_only.tilt_restart_deg, closed(0, 90)},
       {"colour_only", "colour_turns", "frames without depth, meshes whose colours vary: each fitted pose also tried at the turns of a cube and eighth turns about its axes, and this many of the best fitted on (0: off)", &p.colour_only.colour_turns, closed(0, 35)},
       {"colour_only", "restart_rounds", "frames without depth: rounds of those restarts; after the first, the poses a restart improved are fitted again from their own turns and tilts (1: one round)", &p.colour_only.restart_rounds, closed(1, 10)},
+      {"colour_only", "region_contrast_power", "frames without depth: the score is multiplied by the pose's region contrast (how well the frame's colours tell its mask from a band around it, 0..1) to this power (0: off)", &p.colour_only.region_contrast_power, closed(0, 20)},
   };
 }
 

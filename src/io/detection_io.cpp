@@ -82,6 +82,7 @@ nlohmann::ordered_json detectionEntry(const Detection& d) {
     j["contour_edges"] = round(d.contour_edges, 4);
     j["explained_edges"] = round(d.explained_edges, 4);
     if (std::isfinite(d.plain_outline_edges)) j["plain_outline_edges"] = round(d.plain_outline_edges, 4);
+    if (std::isfinite(d.region_contrast)) j["region_contrast"] = round(d.region_contrast, 4);
     j["colour_agreement"] = round(d.colour_agreement, 4);
     j["colour_measured"] = d.colour_measured;
     j["contour_iterations"] = d.icp_iterations;

@@ -67,6 +67,53 @@ double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, cons
   return chromaSpread(n, sr, sg, ss);
 }
 
+float regionContrast(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr, int band_px) {
+  if (scene_bgr.type() != CV_8UC3) throw InputError("regionContrast: the scene must be 8-bit BGR");
+  if (rendering.depth.size() != window.size()) throw InputError("regionContrast: the rendering is not the window's size");
+  if (band_px < 3) throw InputError("regionContrast: the band must reach at least 3 pixels out");
+  // The mask in a canvas grown by the band, so that the band around it fits.
+  const int pad = band_px;
+  cv::Mat mask(window.height + 2 * pad, window.width + 2 * pad, CV_8U, cv::Scalar(0));
+  mask(cv::Rect(pad, pad, window.width, window.height)).setTo(255, rendering.depth > 0.f);
+  const auto disc = [](int radius) { return cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * radius + 1, 2 * radius + 1}); };
+  cv::Mat inside, near, band;
+  cv::erode(mask, inside, disc(2));  // 2 px off the outline either way: a pose a pixel off
+  cv::dilate(mask, near, disc(2));   // would count the other side's colours
+  cv::dilate(mask, band, disc(pad));
+  band.setTo(0, near);
+  constexpr int kLevels = 8, kBins = kLevels * kLevels * kLevels;
+  std::vector<float> hist_in(kBins, 0.f), hist_out(kBins, 0.f);
+  std::vector<int> bins_in, bins_out;
+  for (int y = 0; y < mask.rows; ++y) {
+    const int sy = y + window.y - pad;
+    if (sy < 0 || sy >= scene_bgr.rows) continue;
+    for (int x = 0; x < mask.cols; ++x) {
+      const int sx = x + window.x - pad;
+      if (sx < 0 || sx >= scene_bgr.cols) continue;
+      const bool in = inside.at<uint8_t>(y, x) != 0;
+      if (!in && !band.at<uint8_t>(y, x)) continue;
+      const cv::Vec3b c = scene_bgr.at<cv::Vec3b>(sy, sx);
+      const int bin = ((c[0] * kLevels) >> 8) * kLevels * kLevels + ((c[1] * kLevels) >> 8) * kLevels + ((c[2] * kLevels) >> 8);
+      (in ? hist_in : hist_out)[static_cast<std::size_t>(bin)] += 1.f;
+      (in ? bins_in : bins_out).push_back(bin);
+    }
+  }
+  if (bins_in.size() < static_cast<std::size_t>(kMinColourPixels) || bins_out.size() < static_cast<std::size_t>(kMinColourPixels))
+    return 0.f;
+  // Each side's frequencies, smoothed by half a pixel a bin so that a colour one side lacks
+  // does not decide alone.
+  const float n_in = static_cast<float>(bins_in.size()) + 0.5f * kBins;
+  const float n_out = static_cast<float>(bins_out.size()) + 0.5f * kBins;
+  const auto inSide = [&](int bin) {
+    const auto b = static_cast<std::size_t>(bin);
+    return (hist_in[b] + 0.5f) / n_in > (hist_out[b] + 0.5f) / n_out;
+  };
+  const auto own_in = std::count_if(bins_in.begin(), bins_in.end(), inSide);
+  const auto own_out = static_cast<std::ptrdiff_t>(bins_out.size()) - std::count_if(bins_out.begin(), bins_out.end(), inSide);
+  return static_cast<float>(own_in) / static_cast<float>(bins_in.size()) +
+         static_cast<float>(own_out) / static_cast<float>(bins_out.size()) - 1.f;
+}
+
 AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr,
                                         const cv::Mat& scene_depth_m, float depth_tolerance, bool colour_counts) {
   if (scene_bgr.type() != CV_8UC3 || scene_depth_m.type() != CV_32FC1 || scene_bgr.size() != scene_depth_m.size())

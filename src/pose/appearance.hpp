@@ -43,6 +43,16 @@ double meshChromaSpread(const Mesh& mesh);
 /// surface of one colour. `rendering` covers `window` of `scene_bgr` (CV_8UC3).
 double seenChromaSpread(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr);
 
+/// How well the scene's colours tell the rendering's mask from its surroundings: of the pixels
+/// 2 px and more inside the mask and of those 2 to `band_px` px outside it,
+/// the share that colour histograms of the two (8 levels a channel) assign to their own side,
+/// both shares added less 1 (0: the same colours on both sides, 1: told apart everywhere; the
+/// histograms are of the pixels they judge, so a few dozen pixels of noise already score above
+/// 0). A pose on its object separates the object from what lies around it; a pose tilted or
+/// scaled off it, or laid inside a larger object, takes in some of its surroundings or leaves
+/// some of the object outside. 0 where either side has fewer than 20 pixels in the scene.
+float regionContrast(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr, int band_px = 12);
+
 /// `rendering` covers `window` of the scene (MeshRenderer::render through windowCamera).
 /// scene_bgr: CV_8UC3, scene_depth_m: CV_32FC1 (0 = none), both full frames of one size.
 /// Without `colour_counts` the score is the depth fit alone.

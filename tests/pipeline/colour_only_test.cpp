@@ -17,6 +17,7 @@
 #include "pose/initial_pose.hpp"
 #include "render/render.hpp"
 #include "test_support.hpp"
+#include "vkpose/error.hpp"
 #include "vkpose/evaluation.hpp"
 
 namespace vkpose {
@@ -412,6 +413,66 @@ TEST(ColourOnly, AMeshWithoutColoursIsVerifiedByItsOutlineOverOneColourAndByMore
   EXPECT_FALSE(inside.outline_passed);
   EXPECT_NE(inside.detection.rejection.find("of its outline alone"), std::string::npos) << inside.detection.rejection;
   EXPECT_NE(inside.detection.rejection.find("85 % needed"), std::string::npos) << inside.detection.rejection;
+}
+
+TEST(ColourOnly, RegionContrastIsHighestWhereTheMaskSeparatesTheObjectFromItsSurroundings) {
+  PlainBoxScene s;
+  MeshRenderer renderer(test::context(), s.mesh);
+  const cv::Rect frame_rect(0, 0, s.camera.width, s.camera.height);
+  const auto renderedAt = [&](const Pose& p) { return renderer.render(s.camera, {p}).front(); };
+  // The box blue on a grey table with a little noise, as a sensor gives.
+  cv::Mat noise(s.camera.height, s.camera.width, CV_16SC3);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(6));
+  const auto noisy = [&](const cv::Mat& bgr) {
+    cv::Mat wide, out;
+    bgr.convertTo(wide, CV_16SC3);
+    cv::Mat(wide + noise).convertTo(out, CV_8UC3);
+    return out;
+  };
+  const cv::Mat frame = noisy(s.frame(renderer, {40, 90, 200}, {40, 90, 200}));
+  const float at_truth = regionContrast(renderedAt(s.truth), frame_rect, frame);
+  EXPECT_GT(at_truth, 0.9f);
+
+  // Shifted by a third of its width, or farther away (smaller, inside the box), the mask takes
+  // in table or leaves box in the band around it.
+  Pose shifted = s.truth;
+  shifted.t.x() += 0.03f;
+  Pose farther = s.truth;
+  farther.t *= 1.4f;
+  EXPECT_LT(regionContrast(renderedAt(shifted), frame_rect, frame), at_truth - 0.15f);
+  EXPECT_LT(regionContrast(renderedAt(farther), frame_rect, frame), at_truth - 0.15f);
+
+  // The same colours on both sides: nothing to tell (the histograms of a few thousand noisy
+  // pixels tell them apart a little by chance).
+  const cv::Mat grey = noisy(cv::Mat(frame.size(), CV_8UC3, cv::Scalar(128, 128, 128)));
+  EXPECT_LT(regionContrast(renderedAt(s.truth), frame_rect, grey), 0.2f);
+
+  // Off the image: too few pixels on a side to say.
+  Pose outside = s.truth;
+  outside.t.x() += 2.f;
+  EXPECT_EQ(regionContrast(renderedAt(outside), frame_rect, frame), 0.f);
+  cv::Mat grey8;
+  cv::cvtColor(frame, grey8, cv::COLOR_BGR2GRAY);
+  EXPECT_THROW(regionContrast(renderedAt(s.truth), frame_rect, grey8), InputError);
+
+  // fitAndVerifyByContour reports it and scores by it (ColourOnlyParams::region_contrast_power).
+  PoseObject object;
+  object.bank = &s.bank;
+  object.renderer = &renderer;
+  object.bounding_radius = 0.5f * s.mesh.diameter;
+  const auto verified = [&](const DetectorParams& p) {
+    std::vector<PoseCandidate> candidates{s.candidateFrom(s.truth)};
+    fitAndVerifyByContour(candidates, {object}, s.camera, frame, edgeDistanceMaps(frame), p);
+    return candidates[0].detection;
+  };
+  const Detection with = verified(DetectorParams{});
+  DetectorParams off;
+  off.colour_only.region_contrast_power = 0.f;
+  const Detection without = verified(off);
+  EXPECT_NEAR(with.region_contrast, at_truth, 0.05f);
+  EXPECT_TRUE(std::isnan(without.region_contrast));
+  EXPECT_NEAR(with.score, without.score * std::pow(with.region_contrast, DetectorParams{}.colour_only.region_contrast_power),
+              1e-4f);
 }
 
 TEST(ColourOnly, TheColourTurnsAreTheCubesTurnsAndEighthTurnsEachOnce) {
