@@ -127,6 +127,11 @@ def test_colour_only_with_depth_none(icbin, icbin_bank):
         # Measured only for a mesh without colours over a surface of one colour.
         assert d.plain_outline_edges is None or 0.0 <= d.plain_outline_edges <= 1.0
         assert ("plain_outline_edges" in d.to_dict()) == (d.plain_outline_edges is not None)
+        # Measured at every pose that was scored; the score holds a power of it.
+        assert d.region_contrast is None or -1.0 <= d.region_contrast <= 1.0
+        assert ("region_contrast" in d.to_dict()) == (d.region_contrast is not None)
+    for d in result.detections:
+        assert d.region_contrast is not None
     doc = json.loads(result.to_json())
     assert doc["depth"] == ""
     assert all(d["colour_only"] for d in doc["detections"])
