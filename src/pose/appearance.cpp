@@ -83,7 +83,7 @@ float regionContrast(const Rendering& rendering, const cv::Rect& window, const c
   band.setTo(0, near);
   constexpr int kLevels = 8, kBins = kLevels * kLevels * kLevels;
   std::vector<float> hist_in(kBins, 0.f), hist_out(kBins, 0.f);
-  std::vector<int> bins_in, bins_out;
+  float n_in = 0.f, n_out = 0.f;
   for (int y = 0; y < mask.rows; ++y) {
     const int sy = y + window.y - pad;
     if (sy < 0 || sy >= scene_bgr.rows) continue;
@@ -95,23 +95,22 @@ float regionContrast(const Rendering& rendering, const cv::Rect& window, const c
       const cv::Vec3b c = scene_bgr.at<cv::Vec3b>(sy, sx);
       const int bin = ((c[0] * kLevels) >> 8) * kLevels * kLevels + ((c[1] * kLevels) >> 8) * kLevels + ((c[2] * kLevels) >> 8);
       (in ? hist_in : hist_out)[static_cast<std::size_t>(bin)] += 1.f;
-      (in ? bins_in : bins_out).push_back(bin);
+      (in ? n_in : n_out) += 1.f;
     }
   }
-  if (bins_in.size() < static_cast<std::size_t>(kMinColourPixels) || bins_out.size() < static_cast<std::size_t>(kMinColourPixels))
-    return 0.f;
-  // Each side's frequencies, smoothed by half a pixel a bin so that a colour one side lacks
-  // does not decide alone.
-  const float n_in = static_cast<float>(bins_in.size()) + 0.5f * kBins;
-  const float n_out = static_cast<float>(bins_out.size()) + 0.5f * kBins;
-  const auto inSide = [&](int bin) {
-    const auto b = static_cast<std::size_t>(bin);
-    return (hist_in[b] + 0.5f) / n_in > (hist_out[b] + 0.5f) / n_out;
-  };
-  const auto own_in = std::count_if(bins_in.begin(), bins_in.end(), inSide);
-  const auto own_out = static_cast<std::ptrdiff_t>(bins_out.size()) - std::count_if(bins_out.begin(), bins_out.end(), inSide);
-  return static_cast<float>(own_in) / static_cast<float>(bins_in.size()) +
-         static_cast<float>(own_out) / static_cast<float>(bins_out.size()) - 1.f;
+  if (n_in < kMinColourPixels || n_out < kMinColourPixels) return 0.f;
+  // Each bin goes to the side where its colour is the more frequent, the frequencies smoothed
+  // by half a pixel a bin so that a colour one side lacks does not decide alone; each side's
+  // pixels in the bins it gets are the ones it claims.
+  const float smoothed_in = n_in + 0.5f * kBins, smoothed_out = n_out + 0.5f * kBins;
+  float own_in = 0.f, own_out = 0.f;
+  for (std::size_t b = 0; b < hist_in.size(); ++b) {
+    if ((hist_in[b] + 0.5f) / smoothed_in > (hist_out[b] + 0.5f) / smoothed_out)
+      own_in += hist_in[b];
+    else
+      own_out += hist_out[b];
+  }
+  return own_in / n_in + own_out / n_out - 1.f;
 }
 
 AppearanceAgreement appearanceAgreement(const Rendering& rendering, const cv::Rect& window, const cv::Mat& scene_bgr,
